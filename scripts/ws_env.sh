@@ -1,0 +1,14 @@
+# Source this: the environment for building and running the workspace with the venv's ROS 2.
+# The ROS 2 wheels install their ament prefix into the venv itself (.venv/share/...), so the
+# venv is the underlay that colcon and CMake must search.
+_repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+export AMENT_PREFIX_PATH="$_repo/.venv${AMENT_PREFIX_PATH:+:$AMENT_PREFIX_PATH}"
+export CMAKE_PREFIX_PATH="$_repo/.venv${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}"
+export PATH="$_repo/.venv/bin:$PATH"
+export ROS_AUTOMATIC_DISCOVERY_RANGE="${ROS_AUTOMATIC_DISCOVERY_RANGE:-LOCALHOST}"
+if [ -f "$_repo/ros2_ws/install/setup.bash" ]; then
+  # colcon's setup scripts reference unset variables
+  set +u
+  . "$_repo/ros2_ws/install/setup.bash"
+fi
+unset _repo

@@ -1,0 +1,1 @@
+"""The swivel car model: the thesis mathematics as a ROS-free library."""

@@ -1,0 +1,55 @@
+"""Every console script the packages declare is installed where `ros2 run` looks
+(install/<pkg>/lib/<pkg>/), starts as a node, and exits cleanly on SIGINT."""
+
+from __future__ import annotations
+
+import ast
+
+import pytest
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from swivel_car_testing import REPO_ROOT, NodeProcess, executable_path, spin_until
+
+PYTHON_PACKAGES = sorted(path.parent.name for path in REPO_ROOT.glob('swivel_car_*/setup.py'))
+
+
+def console_scripts(package: str) -> list[str]:
+    """The console script names in ``package``'s setup.py."""
+    tree = ast.parse((REPO_ROOT / package / 'setup.py').read_text())
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Dict):
+            for key, value in zip(node.keys, node.values):
+                if isinstance(key, ast.Constant) and key.value == 'console_scripts':
+                    return [ast.literal_eval(item).split('=')[0].strip() for item in value.elts]
+    return []
+
+
+EXECUTABLES = [(package, script) for package in PYTHON_PACKAGES
+               for script in console_scripts(package)]
+
+
+def test_every_node_package_declares_executables():
+    assert {package for package, _ in EXECUTABLES} >= {
+        'swivel_car_sim', 'swivel_car_control', 'swivel_car_planner'}
+
+
+@pytest.mark.parametrize('package, executable', EXECUTABLES, ids=lambda v: str(v))
+def test_executable_installed_and_starts(ros_domain, package, executable):
+    domain_id, context = ros_domain
+    path = executable_path(package, executable)
+    assert path.stat().st_mode & 0o111, f'{path} is not executable'
+    process = NodeProcess(package, executable, domain_id)
+    probe = Node('executable_probe', context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(probe)
+    try:
+        spin_until(executor, lambda: not process.running() or len(
+            [n for n in probe.get_node_names() if n != 'executable_probe']) > 0,
+            30.0, f'{executable} to join the ROS graph')
+        assert process.running(), process.output()
+        assert process.stop() == 0, process.output()
+    finally:
+        if process.running():
+            process.kill()
+        executor.shutdown()
+        probe.destroy_node()
