@@ -1,22 +1,19 @@
 """Helpers for tests that run the real nodes: isolated ROS domains, node processes
-started the way `ros2 run` starts them, and waiting on topics in sim time.
+started the way `ros2 run` starts them (from scripts/swivel_car_stack.py), and spinning
+until a condition holds.
 
-Import from any test (the root pytest.ini puts tests/support on sys.path).
+Import from any test (the root pytest.ini puts tests/support and scripts on sys.path).
 """
 
 from __future__ import annotations
 
 import itertools
 import os
-import signal
-import subprocess
-import tempfile
 import time
-from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any, Callable
 
-REPO_ROOT = Path(__file__).resolve().parents[2]
-INSTALL_DIR = Path(os.environ.get('SWIVEL_CAR_INSTALL', REPO_ROOT / 'ros2_ws' / 'install'))
+from swivel_car_stack import (  # noqa: F401  (re-exported for the tests)
+    INSTALL_DIR, REPO_ROOT, NodeProcess, config_path, executable_path, ros_environment)
 
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
 # stragglers are never heard. The base spreads concurrent pytest processes apart.
@@ -26,88 +23,6 @@ _DOMAIN_IDS = itertools.cycle(range(1 + (os.getpid() % 10) * 10, 1 + (os.getpid(
 def next_domain_id() -> int:
     """A ROS_DOMAIN_ID not used by the previous nine calls in this process."""
     return next(_DOMAIN_IDS)
-
-
-def ros_environment(domain_id: int) -> dict[str, str]:
-    """The environment for a node process on ``domain_id``, heard only on this host."""
-    env = dict(os.environ)
-    env['ROS_DOMAIN_ID'] = str(domain_id)
-    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    env['PYTHONUNBUFFERED'] = '1'
-    return env
-
-
-def executable_path(package: str, executable: str) -> Path:
-    """Where colcon installed ``executable`` of ``package``: where `ros2 run` looks."""
-    path = INSTALL_DIR / package / 'lib' / package / executable
-    if not path.is_file():
-        raise FileNotFoundError(f'{path} does not exist: build the workspace (make build)')
-    return path
-
-
-def _parameter_argument(name: str, value: Any) -> str:
-    if isinstance(value, bool):
-        text = 'true' if value else 'false'
-    elif isinstance(value, (list, tuple)):
-        text = '[' + ','.join(str(v) for v in value) + ']'
-    else:
-        text = str(value)
-    return f'{name}:={text}'
-
-
-class NodeProcess:
-    """A node executable running in its own process, its output kept in a log file.
-
-    Parameters
-    ----------
-    package, executable : str
-        As for `ros2 run`.
-    domain_id : int
-        ROS_DOMAIN_ID of the process.
-    parameters : mapping
-        ``-p name:=value`` overrides.
-    params_file : path, optional
-        A ``--params-file``.
-    """
-
-    def __init__(self, package: str, executable: str, domain_id: int,
-                 parameters: Mapping[str, Any] | None = None,
-                 params_file: Path | None = None, extra_args: Iterable[str] = ()) -> None:
-        self.name = f'{package}/{executable}'
-        command = [str(executable_path(package, executable)), *extra_args, '--ros-args']
-        if params_file is not None:
-            command += ['--params-file', str(params_file)]
-        for name, value in (parameters or {}).items():
-            command += ['-p', _parameter_argument(name, value)]
-        self.log = tempfile.NamedTemporaryFile(
-            prefix=f'{executable}-', suffix='.log', delete=False)
-        self.process = subprocess.Popen(
-            command, env=ros_environment(domain_id), stdout=self.log,
-            stderr=subprocess.STDOUT, start_new_session=True)
-
-    def output(self) -> str:
-        """Everything the process printed so far."""
-        return Path(self.log.name).read_text(errors='replace')
-
-    def running(self) -> bool:
-        return self.process.poll() is None
-
-    def stop(self, timeout: float = 10.0) -> int:
-        """SIGINT, then SIGKILL after ``timeout`` seconds; returns the exit code."""
-        if self.process.poll() is None:
-            self.process.send_signal(signal.SIGINT)
-            try:
-                self.process.wait(timeout)
-            except subprocess.TimeoutExpired:
-                os.killpg(self.process.pid, signal.SIGKILL)
-                self.process.wait()
-        self.log.close()
-        return self.process.returncode
-
-    def kill(self) -> None:
-        """SIGKILL, as a crash would end it."""
-        os.killpg(self.process.pid, signal.SIGKILL)
-        self.process.wait()
 
 
 def spin_until(executor: Any, condition: Callable[[], bool], timeout: float,

@@ -1,0 +1,13 @@
+"""Root conftest: import the stack's packages before pytest collects their tests.
+
+With --import-mode=importlib pytest names a test module after its path
+(swivel_car_sim/test/test_physics.py -> swivel_car_sim.test.test_physics) and puts empty
+stand-ins into sys.modules for parents it has not seen, which would hide the real
+swivel_car_sim package from the tests. Importing the real packages first prevents that, and
+lets same-named test files (test_system.py) live in several packages.
+"""
+
+import swivel_car_control  # noqa: F401
+import swivel_car_model  # noqa: F401
+import swivel_car_planner  # noqa: F401
+import swivel_car_sim  # noqa: F401

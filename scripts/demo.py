@@ -1,0 +1,308 @@
+#!/usr/bin/env python3
+"""The main job: the simulated swivel car drives to a step and climbs it.
+
+Starts the stack the way a user would with `ros2 run`: the installed `sim_node`,
+`controller_node`, `odometry_node` and `planner_node`, each in its own process, headless, on
+sim time, in lockstep. Then, like a user: spawns a step in front of the car, drives towards it
+with velocity commands on `cmd_vel`, and asks the planner to climb it through the `climb_step`
+action. Prints a progress line while it runs and a summary at the end, and writes a report
+(plots, rendered frames, index.md) to the report folder. Exit code 0 only if the climb
+succeeded.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import rclpy
+from geometry_msgs.msg import TwistStamped
+from nav_msgs.msg import Odometry
+from rclpy.action import ActionClient
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from sensor_msgs.msg import JointState
+from swivel_car_msgs.action import ClimbStep
+from swivel_car_msgs.msg import StepObstacle, SwivelControllerState
+from swivel_car_msgs.srv import SpawnObstacle
+
+from demo_report import write_report
+from swivel_car_sim.physics import StepSpec
+from swivel_car_stack import REPO_ROOT, NodeProcess, config_path
+
+NODES = (('swivel_car_sim', 'sim_node'), ('swivel_car_control', 'controller_node'),
+         ('swivel_car_control', 'odometry_node'), ('swivel_car_planner', 'planner_node'))
+
+# Lockstep: the physics advances only when the controller has answered, so the demo's outcome
+# does not depend on how busy the machine is.
+NODE_PARAMETERS = {'sim_node': {'lockstep': True, 'lockstep_timeout': 0.5, 'gui': False}}
+
+
+@dataclass
+class Recording:
+    """Time series collected from the stack's topics, stamped in sim time."""
+
+    truth: list[tuple[float, float, float, float, float, float, float, float]] = field(
+        default_factory=list)  # t [s], x, y, z [m], quaternion x, y, z, w
+    odom: list[tuple[float, float, float]] = field(default_factory=list)  # t, x, y
+    joints: list[tuple[float, np.ndarray]] = field(default_factory=list)  # t, positions [rad]
+    control: list[tuple[float, float, float, float, float]] = field(
+        default_factory=list)  # t, set point, measured [rad], rate [rad/s], torque [N m]
+    joint_names: tuple[str, ...] = ()
+
+
+def stamp_seconds(stamp) -> float:
+    return stamp.sec + 1e-9 * stamp.nanosec
+
+
+def pitch_of(qx: float, qy: float, qz: float, qw: float) -> float:
+    """REP-103 pitch (positive nose down). # [rad]"""
+    return math.asin(max(-1.0, min(1.0, 2.0 * (qw * qy - qz * qx))))
+
+
+class DemoNode(Node):
+    """The user's side of the demo: records, spawns the step, drives, asks for the climb."""
+
+    def __init__(self, context) -> None:
+        super().__init__('demo', context=context,
+                         parameter_overrides=[Parameter('use_sim_time', value=True)])
+        self.recording = Recording()
+        self.create_subscription(Odometry, 'ground_truth/odom', self._on_truth, 100)
+        self.create_subscription(Odometry, 'odom', self._on_odom, 100)
+        self.create_subscription(JointState, 'joint_states', self._on_joints, 100)
+        self.create_subscription(SwivelControllerState, 'controller/controller_state',
+                                 self._on_control, 100)
+        self.cmd_vel = self.create_publisher(TwistStamped, 'cmd_vel', 10)
+        self.spawn = self.create_client(SpawnObstacle, 'sim/spawn_obstacle')
+        self.climb = ActionClient(self, ClimbStep, 'climb_step')
+
+    def _on_truth(self, msg: Odometry) -> None:
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        self.recording.truth.append(
+            (stamp_seconds(msg.header.stamp), p.x, p.y, p.z, q.x, q.y, q.z, q.w))
+
+    def _on_odom(self, msg: Odometry) -> None:
+        p = msg.pose.pose.position
+        self.recording.odom.append((stamp_seconds(msg.header.stamp), p.x, p.y))
+
+    def _on_joints(self, msg: JointState) -> None:
+        self.recording.joint_names = tuple(msg.name)
+        self.recording.joints.append((stamp_seconds(msg.header.stamp), np.array(msg.position)))
+
+    def _on_control(self, msg: SwivelControllerState) -> None:
+        self.recording.control.append((stamp_seconds(msg.header.stamp), msg.set_point,
+                                       msg.measured, msg.measured_rate, msg.torque))
+
+    def drive(self, speed: float) -> None:
+        msg = TwistStamped()
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.frame_id = 'base_link'
+        msg.twist.linear.x = speed
+        self.cmd_vel.publish(msg)
+
+
+class Progress:
+    """One progress line: rewritten in place on a terminal, a line per change otherwise."""
+
+    def __init__(self) -> None:
+        self._tty = sys.stdout.isatty()
+        self._last = ''
+
+    def show(self, text: str) -> None:
+        if self._tty:
+            sys.stdout.write('\r' + text.ljust(100)[:100])
+            sys.stdout.flush()
+        elif text.split(' t=')[0] != self._last.split(' t=')[0]:
+            print(text, flush=True)
+        self._last = text
+
+    def done(self) -> None:
+        if self._tty:
+            sys.stdout.write('\n')
+
+
+class DemoError(RuntimeError):
+    """The demo could not do what it set out to do."""
+
+
+def spin_until(executor, condition, wall_timeout: float, what: str) -> None:
+    deadline = time.monotonic() + wall_timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise DemoError(f'timed out after {wall_timeout:.0f} s waiting for {what}')
+        executor.spin_once(timeout_sec=0.05)
+
+
+def demo_step(args: argparse.Namespace) -> StepSpec:
+    """The step the demo spawns, square across the car's path."""
+    return StepSpec(name='demo_step', height=args.step_height, depth=1.0, width=1.6,
+                    distance=args.step_distance, yaw=0.0, friction=1.0)
+
+
+def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Recording]:
+    """Start the stack, drive to the step, climb it. Returns the summary figures and what
+    was recorded."""
+    domain_id = args.domain_id
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    processes = [NodeProcess(package, executable, domain_id,
+                             params_file=config_path(package, f'{executable}.yaml'),
+                             parameters={'use_sim_time': True,
+                                         **NODE_PARAMETERS.get(executable, {})})
+                 for package, executable in NODES]
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    node = DemoNode(context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    wall_start = time.monotonic()
+    try:
+        def check_alive() -> bool:
+            for process in processes:
+                if not process.running():
+                    raise DemoError(f'{process.name} exited:\n{process.output()[-3000:]}')
+            return False
+
+        progress.show('starting the stack: sim, controller, odometry, planner')
+        spin_until(executor, lambda: check_alive() or (
+            node.spawn.service_is_ready() and node.climb.server_is_ready()
+            and node.recording.odom), 90.0, 'the stack to come up')
+
+        step = demo_step(args)
+        obstacle = StepObstacle(name=step.name, height=step.height, depth=step.depth,
+                                width=step.width, distance=step.distance, yaw=step.yaw,
+                                friction=step.friction)
+        spawned = node.spawn.call_async(SpawnObstacle.Request(obstacle=obstacle))
+        spin_until(executor, spawned.done, 30.0, 'sim/spawn_obstacle')
+        if not spawned.result().success:
+            raise DemoError(f'spawning the step failed: {spawned.result().message}')
+
+        start_x = node.recording.odom[-1][1]
+        drive_to = args.step_distance - args.stop_before
+        def travelled() -> float:
+            return node.recording.odom[-1][1] - start_x
+        while travelled() < drive_to:
+            check_alive()
+            node.drive(args.drive_speed)
+            progress.show(f'[drive ] towards the step: {args.step_distance - travelled():.2f} m '
+                          f'to go t={node.recording.odom[-1][0]:.1f} s')
+            spin_until(executor, lambda n=len(node.recording.odom): len(
+                node.recording.odom) > n + 4, 30.0, 'odometry while driving')
+        stopped_at = len(node.recording.truth)
+        while True:
+            node.drive(0.0)
+            spin_until(executor, lambda n=len(node.recording.truth): len(
+                node.recording.truth) > n + 9, 30.0, 'ground truth while stopping')
+            xs = [row[1] for row in node.recording.truth[-10:]]
+            if len(node.recording.truth) - stopped_at > 50 and max(xs) - min(xs) < 1e-3:
+                break
+
+        goal = ClimbStep.Goal(step_height=args.step_height,
+                              step_distance=args.step_distance - travelled(), step_yaw=0.0,
+                              plan_only=False, time_allowance=args.time_allowance)
+        climb_start = node.recording.truth[-1][0]
+        sent = node.climb.send_goal_async(goal, feedback_callback=lambda f: progress.show(
+            f'[{f.feedback.phase_name:>10}] {100 * f.feedback.progress:3.0f} %  swivel '
+            f'{f.feedback.swivel_angle:+.2f} rad  pitch {f.feedback.pitch:+.2f} rad  '
+            f'torque {f.feedback.swivel_torque:+5.1f} N m t={node.recording.truth[-1][0]:.1f} s'))
+        spin_until(executor, lambda: check_alive() or sent.done(), 30.0, 'goal acceptance')
+        if not sent.result().accepted:
+            raise DemoError('the planner rejected the climb goal')
+        result_future = sent.result().get_result_async()
+        spin_until(executor, lambda: check_alive() or result_future.done(),
+                   args.wall_timeout, 'the climb to end')
+        result = result_future.result().result
+        progress.done()
+        climb_end = node.recording.truth[-1][0]
+        return summarise(args, node.recording, result, climb_start, climb_end,
+                         time.monotonic() - wall_start), node.recording
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+        codes = {process.name: process.stop() for process in processes}
+        failed = {name: code for name, code in codes.items() if code not in (0, -2)}
+        if failed:
+            print(f'warning: nodes exited with {failed}', file=sys.stderr)
+
+
+def summarise(args, recording: Recording, result, climb_start: float, climb_end: float,
+              wall_time: float) -> dict:
+    truth = np.array(recording.truth)
+    odom = np.array(recording.odom)
+    # Both start at the robot's initial pose: the sim spawns it at the world origin and the
+    # odometry starts at zero.
+    truth_xy_at_odom_end = np.array([np.interp(odom[-1, 0], truth[:, 0], truth[:, i])
+                                     for i in (1, 2)])
+    path = np.sum(np.hypot(np.diff(truth[:, 1]), np.diff(truth[:, 2])))
+    odom_error = float(np.hypot(*(odom[-1, 1:] - truth_xy_at_odom_end)))
+    return {
+        'success': bool(result.success),
+        'error_code': int(result.error_code),
+        'message': result.message,
+        'step_height': args.step_height,
+        'climb_time': climb_end - climb_start,
+        'sim_time': float(truth[-1, 0]),
+        'wall_time': wall_time,
+        'peak_torque': result.outcome.peak_torque,
+        'energy': result.outcome.energy,
+        'planned_peak_torque': result.plan.peak_torque,
+        'planned_energy': result.plan.energy,
+        'swivel_angle': result.plan.swivel_angle,
+        'final_height': float(truth[-1, 3]),
+        'path_length': float(path),
+        'odometry_error': odom_error,
+        'odometry_error_percent': 100.0 * odom_error / max(path, 1e-9),
+        'climb_start': climb_start,
+        'climb_end': climb_end,
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--step-height', type=float, default=0.06, help='[m]')
+    parser.add_argument('--step-distance', type=float, default=1.2,
+                        help='[m] front axle ground contact to the step edge at the start')
+    parser.add_argument('--stop-before', type=float, default=0.5,
+                        help='[m] stop driving this far before the step, then climb')
+    parser.add_argument('--drive-speed', type=float, default=0.3, help='[m/s]')
+    parser.add_argument('--time-allowance', type=float, default=120.0, help='[s] sim time')
+    parser.add_argument('--wall-timeout', type=float, default=900.0, help='[s]')
+    parser.add_argument('--domain-id', type=int, default=60 + os.getpid() % 40)
+    parser.add_argument('--report', type=Path, default=REPO_ROOT / 'report')
+    args = parser.parse_args(argv)
+
+    progress = Progress()
+    try:
+        summary, recording = run_demo(args, progress)
+    except DemoError as error:
+        progress.done()
+        print(f'demo failed: {error}', file=sys.stderr)
+        return 2
+    print_summary(summary)
+    page = write_report(summary, recording, demo_step(args), args.report)
+    print(f'  report               {page}')
+    return 0 if summary['success'] else 1
+
+
+def print_summary(summary: dict) -> None:
+    print(f"\nclimb {'SUCCEEDED' if summary['success'] else 'FAILED'}: {summary['message']}")
+    print(f"  step height          {summary['step_height']:.3f} m")
+    print(f"  climb time           {summary['climb_time']:.1f} s sim "
+          f"(whole demo {summary['sim_time']:.1f} s sim, {summary['wall_time']:.1f} s wall)")
+    print(f"  peak swivel torque   {summary['peak_torque']:.2f} N m "
+          f"(planned {summary['planned_peak_torque']:.2f})")
+    print(f"  swivel energy        {summary['energy']:.2f} J "
+          f"(planned {summary['planned_energy']:.2f})")
+    print(f"  odometry error       {summary['odometry_error']:.3f} m over "
+          f"{summary['path_length']:.2f} m ({summary['odometry_error_percent']:.1f} %)")
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,140 @@
+"""The demo's report: plots of what the stack did and frames of the climb rendered by
+pybullet's own renderer, in one markdown page beside its PNGs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use('Agg')
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from swivel_car_model.params import SwivelCarParams  # noqa: E402
+from swivel_car_sim.physics import SimConfig, StepSpec, SwivelCarSim  # noqa: E402
+
+FRAME_COUNT = 8
+
+
+def _pitch(quaternions: np.ndarray) -> np.ndarray:
+    """REP-103 pitch (positive nose down) of rows of (x, y, z, w). # [rad]"""
+    x, y, z, w = quaternions.T
+    return np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0))
+
+
+def _shade_climb(axis, summary: dict) -> None:
+    axis.axvspan(summary['climb_start'], summary['climb_end'], color='tab:orange', alpha=0.12,
+                 label='climb_step running')
+
+
+def plot_path(recording, step: StepSpec, out: Path) -> None:
+    truth, odom = np.array(recording.truth), np.array(recording.odom)
+    fig, axis = plt.subplots(figsize=(8, 3.2))
+    axis.plot(truth[:, 1], truth[:, 2], label='ground truth (sim)', linewidth=2.5)
+    axis.plot(odom[:, 1], odom[:, 2], '--', label='odometry (tricycle with offset)')
+    # The robot starts at the world origin, so the step's edge is this far ahead of it.
+    edge = step.distance + SwivelCarParams().wheelbase
+    axis.fill_between([edge, edge + step.depth], -step.width / 2, step.width / 2,
+                      color='grey', alpha=0.25, label=f'step, {step.height * 100:.0f} cm high')
+    axis.set_xlabel('x [m]')
+    axis.set_ylabel('y [m]')
+    axis.set_aspect('equal', adjustable='datalim')
+    axis.legend(loc='best', fontsize=8)
+    axis.set_title('Path of base_link (rear axle middle)')
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+
+
+def plot_time_series(recording, summary: dict, out: Path) -> None:
+    truth, control = np.array(recording.truth), np.array(recording.control)
+    t_control = control[:, 0]
+    torque, rate = control[:, 4], control[:, 3]
+    power = np.abs(torque * rate)
+    energy = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1])
+                                              * np.diff(t_control))])
+    fig, axes = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
+    axes[0].plot(t_control, control[:, 2], label='measured')
+    axes[0].plot(t_control, control[:, 1], '--', label='set point')
+    axes[0].set_ylabel('swivel angle [rad]')
+    axes[1].plot(truth[:, 0], -_pitch(truth[:, 4:8]), color='tab:green')
+    axes[1].set_ylabel('nose-up pitch [rad]')
+    axes[2].plot(t_control, torque, color='tab:red')
+    axes[2].set_ylabel('swivel torque [N m]')
+    axes[3].plot(t_control, energy, color='tab:purple')
+    axes[3].set_ylabel('swivel energy [J]')
+    axes[3].set_xlabel('sim time [s]')
+    for axis in axes:
+        _shade_climb(axis, summary)
+        axis.grid(alpha=0.3)
+    axes[0].legend(loc='best', fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+
+
+def render_frames(recording, summary: dict, step: StepSpec, out: Path) -> None:
+    """Replay the recorded ground truth and joint angles in a fresh pybullet world holding
+    the same robot and step, and render a strip of frames with pybullet's renderer."""
+    truth = np.array(recording.truth)
+    joint_times = np.array([t for t, _ in recording.joints])
+    times = np.linspace(summary['climb_start'], summary['climb_end'], FRAME_COUNT)
+    frames = []
+    with SwivelCarSim(SimConfig()) as sim:
+        sim.spawn_obstacle(step)
+        for t in times:
+            row = truth[np.argmin(np.abs(truth[:, 0] - t))]
+            positions = recording.joints[int(np.argmin(np.abs(joint_times - t)))][1]
+            sim.show_state(row[1:4], row[4:8], dict(zip(recording.joint_names, positions)))
+            frames.append(sim.render(width=320, height=240, target=row[1:4] + [0.2, 0, 0]))
+    fig, axes = plt.subplots(2, FRAME_COUNT // 2, figsize=(12, 4.6))
+    for axis, image, t in zip(axes.flat, frames, times):
+        axis.imshow(image)
+        axis.set_title(f't = {t:.1f} s', fontsize=9)
+        axis.axis('off')
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+    plt.close(fig)
+
+
+def write_report(summary: dict, recording, step: StepSpec, folder: Path) -> Path:
+    """Write the plots, the frames and index.md into ``folder``; return the page's path."""
+    folder.mkdir(parents=True, exist_ok=True)
+    plot_path(recording, step, folder / 'path.png')
+    plot_time_series(recording, summary, folder / 'time_series.png')
+    render_frames(recording, summary, step, folder / 'frames.png')
+    rows = [
+        ('climb', 'succeeded' if summary['success'] else f"failed: {summary['message']}"),
+        ('step height', f"{summary['step_height'] * 100:.1f} cm"),
+        ('swivel angle planned', f"{summary['swivel_angle']:.3f} rad"),
+        ('climb time (sim)', f"{summary['climb_time']:.1f} s"),
+        ('whole demo', f"{summary['sim_time']:.1f} s sim, {summary['wall_time']:.1f} s wall"),
+        ('peak swivel torque', f"{summary['peak_torque']:.2f} N m "
+                               f"(model: {summary['planned_peak_torque']:.2f} N m)"),
+        ('swivel energy', f"{summary['energy']:.2f} J (model: {summary['planned_energy']:.2f} J)"),
+        ('odometry end error', f"{summary['odometry_error'] * 100:.1f} cm over "
+                               f"{summary['path_length']:.2f} m "
+                               f"({summary['odometry_error_percent']:.1f} %)"),
+    ]
+    table = '\n'.join(f'| {name} | {value} |' for name, value in rows)
+    page = folder / 'index.md'
+    page.write_text(f"""# Swivel car demo: driving to a step and climbing it
+
+The stack ran as four processes (`sim_node`, `controller_node`, `odometry_node`,
+`planner_node`) on sim time in lockstep; the demo drove with `cmd_vel` and called the
+`climb_step` action. Shaded: while the climb ran.
+
+| | |
+|---|---|
+{table}
+
+## Frames of the climb (pybullet's renderer, replaying the ground truth)
+![frames](frames.png)
+
+## Path: odometry beside ground truth
+![path](path.png)
+
+## Swivel angle, pitch, swivel torque and energy
+![time series](time_series.png)
+""")
+    return page

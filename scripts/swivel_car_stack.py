@@ -1,0 +1,107 @@
+"""Run the stack's nodes the way `ros2 run` runs them: the installed executables under
+ros2_ws/install/<pkg>/lib/<pkg>/, each in its own process on a chosen ROS domain.
+
+Used by the demo (scripts/demo.py) and by the tests (through tests/support).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import tempfile
+from pathlib import Path
+from typing import Any, Iterable, Mapping
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+INSTALL_DIR = Path(os.environ.get('SWIVEL_CAR_INSTALL', REPO_ROOT / 'ros2_ws' / 'install'))
+
+
+def ros_environment(domain_id: int) -> dict[str, str]:
+    """The environment for a node process on ``domain_id``, heard only on this host."""
+    env = dict(os.environ)
+    env['ROS_DOMAIN_ID'] = str(domain_id)
+    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    env['PYTHONUNBUFFERED'] = '1'
+    return env
+
+
+def executable_path(package: str, executable: str) -> Path:
+    """Where colcon installed ``executable`` of ``package``: where `ros2 run` looks."""
+    path = INSTALL_DIR / package / 'lib' / package / executable
+    if not path.is_file():
+        raise FileNotFoundError(f'{path} does not exist: build the workspace (make build)')
+    return path
+
+
+def _parameter_argument(name: str, value: Any) -> str:
+    if isinstance(value, bool):
+        text = 'true' if value else 'false'
+    elif isinstance(value, (list, tuple)):
+        text = '[' + ','.join(str(v) for v in value) + ']'
+    else:
+        text = str(value)
+    return f'{name}:={text}'
+
+
+class NodeProcess:
+    """A node executable running in its own process, its output kept in a log file.
+
+    Parameters
+    ----------
+    package, executable : str
+        As for `ros2 run`.
+    domain_id : int
+        ROS_DOMAIN_ID of the process.
+    parameters : mapping
+        ``-p name:=value`` overrides.
+    params_file : path, optional
+        A ``--params-file``.
+    """
+
+    def __init__(self, package: str, executable: str, domain_id: int,
+                 parameters: Mapping[str, Any] | None = None,
+                 params_file: Path | None = None, extra_args: Iterable[str] = ()) -> None:
+        self.name = f'{package}/{executable}'
+        command = [str(executable_path(package, executable)), *extra_args, '--ros-args']
+        if params_file is not None:
+            command += ['--params-file', str(params_file)]
+        for name, value in (parameters or {}).items():
+            command += ['-p', _parameter_argument(name, value)]
+        self.log = tempfile.NamedTemporaryFile(
+            prefix=f'{executable}-', suffix='.log', delete=False)
+        self.process = subprocess.Popen(
+            command, env=ros_environment(domain_id), stdout=self.log,
+            stderr=subprocess.STDOUT, start_new_session=True)
+
+    def output(self) -> str:
+        """Everything the process printed so far."""
+        return Path(self.log.name).read_text(errors='replace')
+
+    def running(self) -> bool:
+        return self.process.poll() is None
+
+    def stop(self, timeout: float = 10.0) -> int:
+        """SIGINT, then SIGKILL after ``timeout`` seconds; returns the exit code."""
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+            try:
+                self.process.wait(timeout)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.process.pid, signal.SIGKILL)
+                self.process.wait()
+        self.log.close()
+        return self.process.returncode
+
+    def kill(self) -> None:
+        """SIGKILL, as a crash would end it."""
+        os.killpg(self.process.pid, signal.SIGKILL)
+        self.process.wait()
+
+
+def config_path(package: str, file_name: str) -> Path:
+    """An installed parameter file: share/<package>/config/<file_name>."""
+    path = INSTALL_DIR / package / 'share' / package / 'config' / file_name
+    if not path.is_file():
+        raise FileNotFoundError(f'{path} does not exist: build the workspace (make build)')
+    return path

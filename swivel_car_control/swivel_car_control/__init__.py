@@ -1,0 +1,1 @@
+"""Swivel car control: swivel PID, cmd_vel handling and odometry."""

@@ -1,0 +1,1 @@
+"""ROS-free core of the controller: PID, limiters, steering map, command arbitration."""

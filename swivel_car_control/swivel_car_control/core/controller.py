@@ -1,0 +1,275 @@
+"""The swivel car controller: command arbitration, limits, deadman, tip-over guard and PID.
+
+One ``step`` per measured joint state gives one actuator command (swivel torque, drive speed);
+``set_cmd_vel`` and ``set_swivel_command`` take the operator's and the planner's commands and
+raise ``ValueError`` (changing nothing) for commands they refuse.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+from swivel_car_model.params import SwivelCarParams
+
+from swivel_car_control.core.limits import SlewLimiter, steering_speed_scale
+from swivel_car_control.core.pid import PidConfig, PidOutput, SwivelPid
+from swivel_car_control.core.steering import (
+    SteeringMap, swivel_is_tip_safe, tip_safe_swivel_limit)
+from swivel_car_model import planar
+
+SOURCE_CMD_VEL = 'cmd_vel'
+SOURCE_SWIVEL_COMMAND = 'swivel_command'
+SOURCE_HOLD = 'hold'
+
+
+@dataclass(frozen=True)
+class ControllerConfig:
+    """Limits and behaviour of the controller (the PID gains live in ``SwivelCarParams``).
+
+    Parameters
+    ----------
+    max_torque : float
+        Swivel torque clamp. # [N m]
+    max_integral_torque : float
+        Clamp on the PID's integral contribution. # [N m]
+    integral_band : float
+        The PID integrates only while |set point - measured| is below this. # [rad]
+    swivel_limit : float
+        Largest |swivel set point|, <= the joint's mechanical limit; reduced further if the
+        tip-over rule needs it. # [rad]
+    max_swivel_rate : float
+        Set-point rate limit. # [rad/s]
+    max_linear_velocity, max_linear_acceleration : float
+        Limits on base_link's forward speed. # [m/s], [m/s^2]
+    max_angular_velocity, max_angular_acceleration : float
+        Limits on the commanded yaw rate. # [rad/s], [rad/s^2]
+    cmd_vel_timeout : float
+        Deadman: a cmd_vel older than this stops the drive and holds the swivel; 0 disables.
+        # [s]
+    slowdown_start, slowdown_stop : float
+        Swivel error (target - measured) below which the drive runs at full speed, and above
+        which it stops; cos(error) between. # [rad]
+    tip_over_margin : float
+        Margin on thesis eq. 72: ``(pi - phi)/2 - theta1 >= tip_over_margin``. # [rad]
+    """
+
+    max_torque: float = 30.0  # [N m]
+    max_integral_torque: float = 15.0  # [N m]
+    integral_band: float = 0.05  # [rad]
+    swivel_limit: float = 1.4  # [rad]
+    max_swivel_rate: float = 1.5  # [rad/s]
+    max_linear_velocity: float = 0.5  # [m/s]
+    max_linear_acceleration: float = 1.0  # [m/s^2]
+    max_angular_velocity: float = 2.0  # [rad/s]
+    max_angular_acceleration: float = 4.0  # [rad/s^2]
+    cmd_vel_timeout: float = 0.5  # [s]
+    slowdown_start: float = 0.15  # [rad]
+    slowdown_stop: float = 0.6  # [rad]
+    tip_over_margin: float = 0.1  # [rad]
+
+    def __post_init__(self) -> None:
+        for field in fields(self):
+            value = getattr(self, field.name)
+            if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0.0:
+                raise ValueError(f'{field.name} must be a finite number >= 0, got {value!r}')
+        for name in ('max_torque', 'integral_band', 'swivel_limit', 'max_swivel_rate',
+                     'max_linear_velocity',
+                     'max_linear_acceleration', 'max_angular_velocity',
+                     'max_angular_acceleration'):
+            if getattr(self, name) <= 0.0:
+                raise ValueError(f'{name} must be > 0, got {getattr(self, name)!r}')
+        if not self.slowdown_start <= self.slowdown_stop <= math.pi / 2:
+            raise ValueError(
+                'need 0 <= slowdown_start <= slowdown_stop <= pi/2, got '
+                f'{self.slowdown_start!r}, {self.slowdown_stop!r}')
+
+
+@dataclass(frozen=True)
+class SwivelCommandRequest:
+    """The planner's direct command, as accepted."""
+
+    angle: float  # [rad]
+    max_rate: float  # [rad/s], 0 = controller default
+    drive_speed: float  # [rad/s] at the wheels
+
+
+@dataclass(frozen=True)
+class ControlOutput:
+    """One control period's command and the state behind it."""
+
+    swivel_torque: float  # [N m]
+    drive_speed: float  # [rad/s] at the wheels
+    set_point: float  # [rad] after the rate limiter
+    target: float  # [rad] before the rate limiter
+    pid: PidOutput
+    source: str  # SOURCE_*
+    v_out: float  # [m/s] commanded forward speed
+    omega_out: float  # [rad/s] yaw rate the car will have at this speed once steered
+    cmd_vel_timed_out: bool
+
+
+class SwivelController:
+    """Controller core; see the module docstring.
+
+    Parameters
+    ----------
+    p : SwivelCarParams
+        Geometry and the PID gains ``kp, ki, kd``.
+    config : ControllerConfig
+
+    Raises
+    ------
+    ValueError
+        ``config.swivel_limit`` beyond the joint limit, or the tip-over rule unsatisfiable.
+    """
+
+    def __init__(self, p: SwivelCarParams, config: ControllerConfig) -> None:
+        self.p = p
+        self.config = config
+        if config.swivel_limit > p.max_swivel_angle:
+            raise ValueError(f'swivel_limit {config.swivel_limit!r} rad exceeds the joint '
+                             f'limit max_swivel_angle {p.max_swivel_angle!r} rad')
+        self.swivel_limit = tip_safe_swivel_limit(p, config.swivel_limit,
+                                                  config.tip_over_margin)  # [rad]
+        self.steering = SteeringMap(p, self.swivel_limit, config.max_linear_velocity)
+        self.pid = SwivelPid(PidConfig(p.kp, p.ki, p.kd, config.max_torque,
+                                       config.max_integral_torque, config.integral_band))
+        self._v = SlewLimiter(config.max_linear_velocity, config.max_linear_acceleration)
+        self._omega = SlewLimiter(config.max_angular_velocity, config.max_angular_acceleration)
+        self._drive = SlewLimiter(config.max_linear_velocity / p.r,
+                                  config.max_linear_acceleration / p.r)
+        self._set_point = SlewLimiter(self.swivel_limit, config.max_swivel_rate)
+        self._target: float | None = None  # [rad]; None until the first measurement
+        self._last_time: float | None = None  # [s]
+        self._cmd_vel: tuple[float, float, float] | None = None  # (v, omega, stamp)
+        self._swivel_command: SwivelCommandRequest | None = None
+
+    @property
+    def swivel_command(self) -> SwivelCommandRequest | None:
+        """The planner's command being held, if any."""
+        return self._swivel_command
+
+    def set_cmd_vel(self, v: float, omega: float, stamp: float) -> None:
+        """Take a velocity command: v [m/s], omega [rad/s], stamp [s] (its time).
+
+        Raises
+        ------
+        ValueError
+            A field is not finite; the last command stays.
+        """
+        for name, value in (('linear.x', v), ('angular.z', omega), ('stamp', stamp)):
+            if not math.isfinite(value):
+                raise ValueError(f'cmd_vel {name} is {value!r}: rejected, keeping the last '
+                                 'safe command')
+        self._cmd_vel = (float(v), float(omega), float(stamp))
+
+    def set_swivel_command(self, angle: float, max_rate: float, drive_speed: float,
+                           hold: bool) -> None:
+        """Take the planner's direct command; ``hold=False`` releases it to cmd_vel.
+
+        Raises
+        ------
+        ValueError
+            Non-finite field, angle beyond the swivel limit, negative rate, or an angle that
+            breaks the tip-over rule with the margin; the previous command stays.
+        """
+        if not hold:
+            self._swivel_command = None
+            return
+        for name, value in (('angle', angle), ('max_rate', max_rate),
+                            ('drive_speed', drive_speed)):
+            if not math.isfinite(value):
+                raise ValueError(f'swivel_command {name} is {value!r}: refused')
+        if max_rate < 0.0:
+            raise ValueError(f'swivel_command max_rate must be >= 0, got {max_rate!r}: refused')
+        limit = self.config.swivel_limit
+        if abs(angle) > limit:
+            raise ValueError(f'swivel_command angle {angle!r} rad is outside +-{limit!r} rad: '
+                             'refused')
+        # Beyond the tip-safe limit the way there crosses unsafe angles even where the target
+        # itself would be safe (the lift angle peaks inside the swivel range).
+        if abs(angle) > self.swivel_limit or not swivel_is_tip_safe(
+                self.p, angle, self.config.tip_over_margin):
+            raise ValueError(
+                f'swivel_command angle {angle!r} rad breaks the tip-over rule (thesis eq. 72) '
+                f'with margin {self.config.tip_over_margin!r} rad: refused')
+        self._swivel_command = SwivelCommandRequest(float(angle), float(max_rate),
+                                                    float(drive_speed))
+
+    def step(self, t: float, measured: float, measured_rate: float) -> ControlOutput:
+        """One control period at time ``t`` [s] with the measured swivel angle [rad] and rate
+        [rad/s]. Time going backwards (a sim reset) restarts the controller's memory."""
+        for name, value in (('t', t), ('measured', measured), ('measured_rate', measured_rate)):
+            if not math.isfinite(value):
+                raise ValueError(f'{name} must be finite, got {value!r}')
+        if self._last_time is None or t < self._last_time:
+            self._restart(measured)
+            dt = 0.0
+        else:
+            dt = t - self._last_time
+        self._last_time = t
+        timed_out = False
+        max_rate = None
+        command = self._swivel_command
+        if command is not None:
+            source = SOURCE_SWIVEL_COMMAND
+            self._target = command.angle
+            if command.max_rate > 0.0:
+                max_rate = command.max_rate
+            drive_target = command.drive_speed
+            # The rate limiters follow along, so a release continues smoothly.
+            self._v.step(drive_target * self.p.r, dt)
+            self._omega.step(0.0, dt)
+        else:
+            v, omega = 0.0, 0.0
+            if self._cmd_vel is not None:
+                timeout = self.config.cmd_vel_timeout
+                timed_out = timeout > 0.0 and t - self._cmd_vel[2] > timeout
+                if not timed_out:
+                    v, omega = self._cmd_vel[0], self._cmd_vel[1]
+            resolved = self.steering.resolve(self._v.step(v, dt), self._omega.step(omega, dt))
+            if v == 0.0 and omega == 0.0:
+                # Stopping (asked, or deadman): the swivel holds; only the drive ramps down,
+                # so the car keeps its arc instead of steering as v and omega decay unequally.
+                source = SOURCE_HOLD
+                drive_target = 0.0
+            else:
+                source = SOURCE_CMD_VEL
+                if resolved.swivel is not None:  # None while both ramps still sit at zero
+                    self._target = resolved.swivel
+                drive_target = resolved.v / self.p.r
+                if resolved.tightest:
+                    drive_target = self._tightest_turn_speed(resolved.omega, measured) / self.p.r
+        set_point = self._set_point.step(self._target, dt, max_rate)
+        pid = self.pid.step(set_point, measured, measured_rate, dt)
+        scale = steering_speed_scale(self._target - measured, self.config.slowdown_start,
+                                     self.config.slowdown_stop)
+        drive = self._drive.step(drive_target * scale, dt)
+        v_out = drive * self.p.r
+        omega_out = planar.curvature_for_swivel(self.p, self._target) * v_out
+        return ControlOutput(pid.torque, drive, set_point, self._target, pid, source, v_out,
+                             omega_out, timed_out)
+
+    def _tightest_turn_speed(self, omega: float, measured: float) -> float:
+        """Forward speed [m/s] giving the yaw rate ``omega`` [rad/s] at the *measured* swivel.
+
+        Near the swivel limit the curvature is steep in theta2 (4.2 1/m at 1.40 rad, 4.5 at
+        1.41 with the default geometry), so the few hundredths of a radian the swivel sits off
+        its set point under load would change the yaw rate by several per cent; at the limit
+        the speed only serves the yaw rate, so it follows the measured curvature.
+        """
+        limit = self.p.max_swivel_angle
+        curvature = planar.curvature_for_swivel(self.p, max(-limit, min(limit, measured)))
+        if curvature * omega <= 0.0 or abs(curvature) < 0.5 * self.steering.max_curvature:
+            return 0.0  # still steering towards the turn: the speed scale holds the drive
+        return max(-self.config.max_linear_velocity,
+                   min(self.config.max_linear_velocity, omega / curvature))
+
+    def _restart(self, measured: float) -> None:
+        hold = max(-self.swivel_limit, min(self.swivel_limit, measured))
+        self.pid.reset()
+        self._set_point.reset(hold)
+        self._target = hold
+        for limiter in (self._v, self._omega, self._drive):
+            limiter.reset(0.0)

@@ -1,0 +1,210 @@
+"""odometry_node: tricycle-with-variable-offset odometry from joint_states, published on
+``odom`` (REP-105: odom -> base_link, twist in base_link)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+from dataclasses import dataclass
+
+from geometry_msgs.msg import TransformStamped
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from sensor_msgs.msg import JointState
+from std_srvs.srv import Empty
+from swivel_car_model.planar import OffsetTricycleOdometry
+from swivel_car_msgs.srv import SetPose2D
+
+from swivel_car_control.conversions import stamp_to_seconds, yaw_to_quaternion
+from swivel_car_control.joints import JointReader, MissingJointError
+from swivel_car_control.ros_params import (
+    declare_car_params, declare_dataclass, refuse_runtime_changes, run_node)
+
+# 'swivel': the offset tricycle's steering constraint (thesis II.E); 'rear_wheels': the yaw
+# rate from the rear wheels' rate difference (the speed from the model in both cases).
+YAW_RATE_SOURCES = ('swivel', 'rear_wheels')
+# A swivel reading this far past the joint limit (compliance, sensor noise) is clamped to it.
+_LIMIT_SLACK = 0.05  # [rad]
+
+
+@dataclass(frozen=True)
+class OdometryConfig:
+    """Frames, rates and covariances of the odometry node (see CONFIG_DESCRIPTIONS)."""
+
+    publish_rate: float = 50.0  # [Hz]
+    odom_frame_id: str = 'odom'
+    base_frame_id: str = 'base_link'
+    tf_frame_prefix: str = ''
+    enable_odom_tf: bool = True
+    # [m^2, m^2, m^2, rad^2, rad^2, rad^2] for x, y, z, roll, pitch, yaw
+    pose_covariance_diagonal: tuple = (0.001, 0.001, 1e6, 1e6, 1e6, 0.01)
+    # [(m/s)^2 x3, (rad/s)^2 x3]
+    twist_covariance_diagonal: tuple = (0.001, 0.001, 1e6, 1e6, 1e6, 0.01)
+    swivel_joint: str = 'swivel_joint'
+    rear_left_wheel_joint: str = 'rear_left_wheel_joint'
+    rear_right_wheel_joint: str = 'rear_right_wheel_joint'
+    yaw_rate_source: str = 'swivel'
+
+    def __post_init__(self) -> None:
+        if self.yaw_rate_source not in YAW_RATE_SOURCES:
+            raise ValueError(f'yaw_rate_source must be one of {YAW_RATE_SOURCES}, got '
+                             f'{self.yaw_rate_source!r}')
+        if not (isinstance(self.publish_rate, (int, float)) and math.isfinite(self.publish_rate)
+                and self.publish_rate > 0.0):
+            raise ValueError(f'publish_rate must be > 0 Hz, got {self.publish_rate!r}')
+        for name in ('odom_frame_id', 'base_frame_id', 'swivel_joint', 'rear_left_wheel_joint',
+                     'rear_right_wheel_joint'):
+            if not isinstance(getattr(self, name), str) or not getattr(self, name):
+                raise ValueError(f'{name} must be a non-empty string')
+        for name in ('pose_covariance_diagonal', 'twist_covariance_diagonal'):
+            values = getattr(self, name)
+            if len(values) != 6 or not all(
+                    isinstance(v, (int, float)) and math.isfinite(v) and v >= 0.0
+                    for v in values):
+                raise ValueError(f'{name} must be 6 finite numbers >= 0, got {values!r}')
+
+    def frame(self, frame_id: str) -> str:
+        """``frame_id`` with the tf prefix ('robot1' + 'odom' -> 'robot1/odom')."""
+        prefix = self.tf_frame_prefix.strip('/')
+        return f'{prefix}/{frame_id}' if prefix else frame_id
+
+
+CONFIG_DESCRIPTIONS = {
+    'publish_rate': 'rate of odom (and TF) messages [Hz]',
+    'odom_frame_id': 'fixed frame of the odometry (header.frame_id)',
+    'base_frame_id': 'robot frame (child_frame_id)',
+    'tf_frame_prefix': 'prefix for both frame ids, e.g. a robot name; empty = none',
+    'enable_odom_tf': 'broadcast odom -> base_link on /tf (needs tf2_ros)',
+    'pose_covariance_diagonal': 'pose covariance diagonal x y z roll pitch yaw [m^2, rad^2]',
+    'twist_covariance_diagonal': 'twist covariance diagonal [(m/s)^2, (rad/s)^2]',
+    'swivel_joint': 'swivel joint name in joint_states',
+    'rear_left_wheel_joint': 'rear left wheel joint name',
+    'rear_right_wheel_joint': 'rear right wheel joint name',
+    'yaw_rate_source': "yaw rate from 'swivel' (offset tricycle steering constraint) or "
+                       "'rear_wheels' (rear wheel rate difference / track)",
+}
+
+
+def _diagonal(values: tuple) -> list[float]:
+    matrix = [0.0] * 36
+    for i, value in enumerate(values):
+        matrix[7 * i] = float(value)
+    return matrix
+
+
+class OdometryNode(Node):
+    """Offset-tricycle odometry; see the package README for its interface."""
+
+    def __init__(self) -> None:
+        super().__init__('odometry')
+        self._car = declare_car_params(self)
+        self._config = config = declare_dataclass(self, OdometryConfig, CONFIG_DESCRIPTIONS)
+        refuse_runtime_changes(self, {f.name for f in dataclasses.fields(self._car)}
+                               | {f.name for f in dataclasses.fields(config)})
+        self._odometry = OffsetTricycleOdometry(self._car)
+        self._joints = JointReader([config.swivel_joint, config.rear_left_wheel_joint,
+                                    config.rear_right_wheel_joint])
+        self._last_time: float | None = None  # [s] of the last joint_states used
+        self._last_stamp = None
+        self._tf = self._make_tf_broadcaster() if config.enable_odom_tf else None
+
+        self._pose_covariance = _diagonal(config.pose_covariance_diagonal)
+        self._twist_covariance = _diagonal(config.twist_covariance_diagonal)
+        self._odom_pub = self.create_publisher(Odometry, 'odom', 10)
+        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
+        self.create_service(Empty, '~/reset', self._on_reset)
+        self.create_service(SetPose2D, '~/set_pose', self._on_set_pose)
+        self.create_timer(1.0 / config.publish_rate, self._publish)
+
+    def _make_tf_broadcaster(self):
+        try:
+            from tf2_ros import TransformBroadcaster
+        except ImportError as error:
+            self.get_logger().warn(
+                f'tf2_ros is not importable ({error}): NOT broadcasting '
+                f'{self._config.frame(self._config.odom_frame_id)} -> '
+                f'{self._config.frame(self._config.base_frame_id)} on /tf; the pose is only '
+                'on the odom topic')
+            return None
+        return TransformBroadcaster(self)
+
+    def _on_joint_states(self, msg: JointState) -> None:
+        t = stamp_to_seconds(msg.header.stamp)
+        if self._last_time is not None and t < self._last_time:
+            self.get_logger().info('time jumped back (sim reset?): restarting the integration, '
+                                   'pose kept')
+            self._joints.reset()
+            self._last_time = None
+        try:
+            joints = self._joints.read(t, msg.name, msg.position, msg.velocity)
+        except MissingJointError as error:
+            self.get_logger().warn(f'{error}: odometry not updated', throttle_duration_sec=5.0)
+            return
+        c = self._config
+        swivel = joints[c.swivel_joint]
+        limit = self._car.max_swivel_angle
+        theta2 = swivel.position
+        if abs(theta2) <= limit + _LIMIT_SLACK:
+            theta2 = max(-limit, min(limit, theta2))
+        left, right = joints[c.rear_left_wheel_joint].rate, joints[c.rear_right_wheel_joint].rate
+        difference = right - left if c.yaw_rate_source == 'rear_wheels' else None
+        dt = 0.0 if self._last_time is None else t - self._last_time
+        try:
+            self._odometry.update(theta2, swivel.rate, 0.5 * (left + right), dt, difference)
+        except ValueError as error:
+            self.get_logger().warn(f'odometry not updated: {error}', throttle_duration_sec=5.0)
+            return
+        self._last_time = t
+        self._last_stamp = msg.header.stamp
+
+    def _publish(self) -> None:
+        if self._last_stamp is None:
+            return
+        c = self._config
+        odometry = self._odometry
+        msg = Odometry()
+        msg.header.stamp = self._last_stamp
+        msg.header.frame_id = c.frame(c.odom_frame_id)
+        msg.child_frame_id = c.frame(c.base_frame_id)
+        msg.pose.pose.position.x = odometry.x
+        msg.pose.pose.position.y = odometry.y
+        msg.pose.pose.orientation = yaw_to_quaternion(odometry.yaw)
+        msg.pose.covariance = self._pose_covariance
+        msg.twist.twist.linear.x = odometry.v
+        msg.twist.twist.angular.z = odometry.omega
+        msg.twist.covariance = self._twist_covariance
+        self._odom_pub.publish(msg)
+        if self._tf is not None:
+            transform = TransformStamped()
+            transform.header = msg.header
+            transform.child_frame_id = msg.child_frame_id
+            transform.transform.translation.x = odometry.x
+            transform.transform.translation.y = odometry.y
+            transform.transform.rotation = msg.pose.pose.orientation
+            self._tf.sendTransform(transform)
+
+    def _on_reset(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
+        self._odometry.reset()
+        self.get_logger().info('odometry reset to the origin')
+        return response
+
+    def _on_set_pose(self, request: SetPose2D.Request,
+                     response: SetPose2D.Response) -> SetPose2D.Response:
+        try:
+            self._odometry.set_pose(request.x, request.y, request.yaw)
+        except ValueError as error:
+            response.success = False
+            response.message = f'pose refused: {error}'
+            return response
+        response.success = True
+        response.message = f'pose set to ({request.x}, {request.y}, {request.yaw})'
+        return response
+
+
+def main(args=None) -> None:
+    sys.exit(run_node(OdometryNode, 'odometry', args))
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,95 @@
+"""ROS glue shared by the nodes: config dataclasses as parameters, the main loop."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Mapping, TypeVar
+
+import rclpy
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from swivel_car_model.params import SwivelCarParams
+
+T = TypeVar('T')
+
+CAR_DESCRIPTIONS = {
+    'l': 'T column length, axle centre to apex [m]',
+    'h': 'half wheel shaft: wheel centre plane to the column [m]',
+    'phi': 'angle between the T columns (each rises at phi/2) [rad]',
+    'r': 'wheel radius [m]',
+    'mass': 'total mass [kg]',
+    'inertia': 'inertia about the rear axle (thesis I_s) [kg m^2]',
+    'kp': 'swivel PID proportional gain [N m/rad]',
+    'ki': 'swivel PID integral gain [N m/(rad s)]',
+    'kd': 'swivel PID derivative gain, on the measured rate [N m s/rad]',
+    'wheel_width': 'wheel tread width [m]',
+    'wheel_mass': 'mass of one wheel [kg]',
+    'max_swivel_angle': 'mechanical swivel joint limit, symmetric [rad]',
+}
+
+
+def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],
+                      defaults: Mapping[str, Any] | None = None) -> T:
+    """Declare one parameter per field of ``cls`` and build it from their values.
+
+    Raises
+    ------
+    ValueError
+        The dataclass refuses the values; the message names the field.
+    """
+    values = {}
+    for field in dataclasses.fields(cls):
+        default = (defaults or {}).get(field.name, field.default)
+        if isinstance(default, int) and not isinstance(default, bool):
+            default = float(default)
+        value = node.declare_parameter(
+            field.name, list(default) if isinstance(default, tuple) else default,
+            # Dynamic typing lets `kp:=19` (an integer) through; the dataclass validates.
+            ParameterDescriptor(description=descriptions[field.name],
+                                dynamic_typing=True)).value
+        values[field.name] = tuple(value) if isinstance(default, tuple) else value
+    return cls(**values)
+
+
+def declare_car_params(node: Node, defaults: Mapping[str, Any] | None = None
+                       ) -> SwivelCarParams:
+    """The car's geometry, masses and swivel gains as parameters (defaults: thesis Table 2,
+    unless ``defaults`` overrides some)."""
+    return declare_dataclass(node, SwivelCarParams, CAR_DESCRIPTIONS, defaults)
+
+
+def refuse_runtime_changes(node: Node, names: set[str]) -> None:
+    """Parameters are read once at start: refuse later changes with a clear reason."""
+
+    def callback(parameters: list) -> SetParametersResult:
+        changed = sorted(p.name for p in parameters if p.name in names)
+        if changed:
+            return SetParametersResult(
+                successful=False,
+                reason=f'{", ".join(changed)} are read at start-up; restart the node to change')
+        return SetParametersResult(successful=True)
+
+    node.add_on_set_parameters_callback(callback)
+
+
+def run_node(node_class: type[Node], name: str, args: list[str] | None = None) -> int:
+    """The Jazzy main loop for one node; a refused parameter ends it with a clear error.
+
+    Returns the process exit code (0, or 1 for a configuration error).
+    """
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = node_class()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except ValueError as error:
+        rclpy.logging.get_logger(name).fatal(f'bad configuration: {error}')
+        return 1
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0

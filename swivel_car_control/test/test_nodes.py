@@ -1,0 +1,264 @@
+"""In-process node tests: real rclpy, the nodes' topics and services, driven by hand-made
+joint_states (no sim), each test on a fresh ROS domain."""
+
+import math
+import os
+
+import pytest
+import rclpy
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import Twist, TwistStamped
+from nav_msgs.msg import Odometry
+from rclpy.executors import SingleThreadedExecutor
+from sensor_msgs.msg import JointState
+from std_srvs.srv import Empty
+from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
+from swivel_car_msgs.srv import SetPose2D
+from swivel_car_testing import next_domain_id, spin_until
+
+from swivel_car_control.controller_node import ControllerNode
+from swivel_car_control.odometry_node import OdometryNode
+
+JOINTS = ['swivel_joint', 'rear_left_wheel_joint', 'rear_right_wheel_joint',
+          'front_left_wheel_joint', 'front_right_wheel_joint']
+
+
+class Harness:
+    """A node under test plus a probe node that publishes inputs and records outputs."""
+
+    def __init__(self, node_class, parameters):
+        os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+        args = ['--ros-args'] + [a for k, v in parameters.items() for a in ('-p', f'{k}:={v}')]
+        rclpy.init(args=args, domain_id=next_domain_id())
+        self.node = node_class()
+        self.probe = rclpy.create_node('probe')
+        self.executor = SingleThreadedExecutor()
+        self.executor.add_node(self.node)
+        self.executor.add_node(self.probe)
+        self.received = {}
+
+    def record(self, msg_type, topic):
+        self.received[topic] = []
+        self.probe.create_subscription(msg_type, topic, self.received[topic].append, 10)
+
+    def wait_connected(self, publisher):
+        spin_until(self.executor, lambda: publisher.get_subscription_count() > 0, 10.0,
+                   'subscription')
+
+    def close(self):
+        self.executor.shutdown()
+        self.probe.destroy_node()
+        self.node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def joint_state(t, swivel=0.0, swivel_rate=0.0, wheel_rate=0.0, names=JOINTS):
+    msg = JointState()
+    msg.header.stamp = Time(sec=int(t), nanosec=int(round((t - int(t)) * 1e9)))
+    values = {'swivel_joint': (swivel, swivel_rate)}
+    msg.name = list(names)
+    msg.position = [values.get(n, (0.0, 0.0))[0] for n in names]
+    msg.velocity = [values.get(n, (0.0, wheel_rate))[1] for n in names]
+    return msg
+
+
+@pytest.fixture
+def controller():
+    harness = Harness(ControllerNode, {'cmd_vel_timeout': 0.5})
+    harness.record(ActuatorCommand, 'actuator_command')
+    harness.record(SwivelControllerState, 'controller/controller_state')
+    harness.record(TwistStamped, 'controller/cmd_vel_out')
+    harness.joints = harness.probe.create_publisher(JointState, 'joint_states', 10)
+    harness.cmd_vel = harness.probe.create_publisher(TwistStamped, 'cmd_vel', 10)
+    harness.swivel = harness.probe.create_publisher(SwivelCommand, 'swivel_command', 10)
+    for publisher in (harness.joints, harness.cmd_vel, harness.swivel):
+        harness.wait_connected(publisher)
+    spin_until(harness.executor, lambda: all(
+        harness.probe.count_publishers(topic) for topic in harness.received), 10.0, 'publishers')
+    yield harness
+    harness.close()
+
+
+def step(harness, t, **joint):
+    """Publish joint_states at t; wait for the command stamped t (the lockstep contract)."""
+    commands = harness.received['actuator_command']
+    count = len(commands)
+    harness.joints.publish(joint_state(t, **joint))
+    spin_until(harness.executor, lambda: len(commands) > count, 10.0, f'command at {t}')
+    command = commands[-1]
+    assert command.header.stamp == joint_state(t).header.stamp
+    return command
+
+
+def send_cmd_vel(harness, v, omega, t):
+    msg = TwistStamped()
+    msg.header.stamp = joint_state(t).header.stamp
+    msg.twist.linear.x = v
+    msg.twist.angular.z = omega
+    harness.cmd_vel.publish(msg)
+    # Spin until the controller has it (nothing to observe but time): a few spins suffice.
+    for _ in range(20):
+        harness.executor.spin_once(timeout_sec=0.01)
+
+
+def test_one_command_per_joint_state_with_its_stamp(controller):
+    for k in range(5):
+        command = step(controller, 1.0 + 0.01 * k, swivel=0.1)
+        assert math.isfinite(command.swivel_torque)
+    spin_until(controller.executor,
+               lambda: len(controller.received['controller/controller_state']) >= 5, 10.0, 'state')
+    state = controller.received['controller/controller_state'][-1]
+    assert state.source == 'hold'
+    assert state.measured == pytest.approx(0.1)
+    assert state.set_point == pytest.approx(0.1)
+
+
+def test_cmd_vel_drives_and_nan_is_rejected(controller):
+    t = 1.0
+    step(controller, t)
+    send_cmd_vel(controller, 0.3, 0.0, t)
+    for k in range(1, 50):
+        command = step(controller, t + 0.01 * k)
+    send_cmd_vel(controller, 0.3, 0.0, t + 0.45)
+    assert command.drive_speed == pytest.approx(0.3 / 0.075)
+    send_cmd_vel(controller, math.nan, 0.0, t + 0.49)
+    for k in range(50, 60):
+        command = step(controller, t + 0.01 * k)
+    assert command.drive_speed == pytest.approx(0.3 / 0.075)
+    spin_until(controller.executor,
+               lambda: controller.received['controller/cmd_vel_out'], 10.0, 'cmd_vel_out')
+    assert controller.received['controller/cmd_vel_out'][-1].twist.linear.x == pytest.approx(0.3)
+    # The deadman: no new command for 0.5 s of joint_states time stops the drive.
+    for k in range(60, 95):
+        command = step(controller, t + 0.01 * k)
+    assert command.drive_speed == pytest.approx(0.3 / 0.075)
+    for k in range(100, 200):
+        command = step(controller, t + 0.01 * k)
+    assert command.drive_speed == 0.0
+
+
+def test_turn_on_the_spot_command_steers_to_the_limit(controller):
+    step(controller, 1.0)
+    send_cmd_vel(controller, 0.0, 1.0, 1.0)
+    states = controller.received['controller/controller_state']
+    for k in range(1, 50):
+        step(controller, 1.0 + 0.01 * k)
+        spin_until(controller.executor, lambda: len(states) > k, 10.0, 'state')
+        if states[-1].source == 'cmd_vel':
+            break
+    assert states[-1].source == 'cmd_vel'
+    assert states[-1].target == pytest.approx(-1.4)  # left turn: negative swivel, phi > 0
+
+
+def test_missing_swivel_joint_gives_a_safe_command(controller):
+    commands = controller.received['actuator_command']
+    controller.joints.publish(joint_state(2.0, names=['rear_left_wheel_joint']))
+    spin_until(controller.executor, lambda: commands, 10.0, 'command')
+    assert (commands[-1].swivel_torque, commands[-1].drive_speed) == (0.0, 0.0)
+
+
+def test_swivel_command_and_refusal(controller):
+    step(controller, 1.0)
+    refused = SwivelCommand(angle=3.0, hold=True)
+    controller.swivel.publish(refused)
+    step(controller, 1.01)
+    accepted = SwivelCommand(angle=0.5, max_rate=0.0, drive_speed=1.0, hold=True)
+    controller.swivel.publish(accepted)
+    states = controller.received['controller/controller_state']
+    spin_until(controller.executor, lambda: states, 10.0, 'state')
+    assert states[-1].source == 'hold'
+    for k in range(2, 10):
+        step(controller, 1.0 + 0.01 * k, swivel=0.5)
+    spin_until(controller.executor,
+               lambda: states[-1].source == 'swivel_command', 10.0, 'swivel_command source')
+    assert states[-1].target == 0.5
+
+
+def test_plain_twist_parameter():
+    harness = Harness(ControllerNode, {'use_stamped': False, 'cmd_vel_timeout': 0.0})
+    try:
+        harness.record(ActuatorCommand, 'actuator_command')
+        harness.joints = harness.probe.create_publisher(JointState, 'joint_states', 10)
+        cmd_vel = harness.probe.create_publisher(Twist, 'cmd_vel', 10)
+        for publisher in (harness.joints, cmd_vel):
+            harness.wait_connected(publisher)
+        spin_until(harness.executor, lambda: harness.probe.count_publishers(
+            'actuator_command'), 10.0, 'publisher')
+        step(harness, 1.0)
+        twist = Twist()
+        twist.linear.x = 0.2
+        cmd_vel.publish(twist)
+        for k in range(1, 100):
+            command = step(harness, 1.0 + 0.01 * k)
+            if command.drive_speed > 0.0:
+                break
+        assert command.drive_speed > 0.0
+    finally:
+        harness.close()
+
+
+@pytest.fixture
+def odometry():
+    harness = Harness(OdometryNode, {'publish_rate': 100.0, 'tf_frame_prefix': 'robot1'})
+    harness.record(Odometry, 'odom')
+    harness.joints = harness.probe.create_publisher(JointState, 'joint_states', 10)
+    harness.wait_connected(harness.joints)
+    yield harness
+    harness.close()
+
+
+def feed(harness, t0, seconds, **joint):
+    for k in range(int(round(seconds / 0.01)) + 1):
+        harness.joints.publish(joint_state(t0 + 0.01 * k, **joint))
+        harness.executor.spin_once(timeout_sec=0.005)
+    spin_until(harness.executor, lambda: harness.received['odom'] and harness.received['odom'][
+        -1].header.stamp == joint_state(t0 + seconds).header.stamp, 10.0, 'odom of last input')
+    return harness.received['odom'][-1]
+
+
+def call(harness, service_type, name, request):
+    client = harness.probe.create_client(service_type, name)
+    assert client.wait_for_service(timeout_sec=10.0)
+    future = client.call_async(request)
+    spin_until(harness.executor, future.done, 10.0, name)
+    return future.result()
+
+
+def test_odometry_straight_frames_reset_and_set_pose(odometry):
+    odom = feed(odometry, 1.0, 1.0, wheel_rate=2.0)
+    assert odom.header.frame_id == 'robot1/odom'
+    assert odom.child_frame_id == 'robot1/base_link'
+    assert odom.pose.pose.position.x == pytest.approx(2.0 * 0.075 * 1.0, rel=1e-6)
+    assert odom.twist.twist.linear.x == pytest.approx(0.15)
+    assert odom.pose.covariance[0] == 0.001
+    call(odometry, Empty, 'odometry/reset', Empty.Request())
+    odom = feed(odometry, 2.01, 0.5)
+    assert odom.pose.pose.position.x == pytest.approx(0.0, abs=1e-9)
+    response = call(odometry, SetPose2D, 'odometry/set_pose', SetPose2D.Request(
+        x=1.0, y=2.0, yaw=math.pi / 2))
+    assert response.success
+    odom = feed(odometry, 2.52, 0.2)
+    assert (odom.pose.pose.position.x, odom.pose.pose.position.y) == pytest.approx((1.0, 2.0))
+    assert odom.pose.pose.orientation.z == pytest.approx(math.sin(math.pi / 4))
+    bad = call(odometry, SetPose2D, 'odometry/set_pose', SetPose2D.Request(x=math.nan))
+    assert not bad.success and 'finite' in bad.message
+    odom = feed(odometry, 2.73, 0.1)
+    assert odom.pose.pose.position.x == pytest.approx(1.0)
+
+
+def test_odometry_without_velocities_differences_wrapped_positions(odometry):
+    msgs = []
+    for k in range(101):
+        t = 1.0 + 0.01 * k
+        angle = math.remainder(10.0 * (t - 1.0), 2 * math.pi)  # wraps at +-pi
+        msg = joint_state(t)
+        msg.position = [0.0, angle, angle, 0.0, 0.0]
+        msg.velocity = []
+        msgs.append(msg)
+    for msg in msgs:
+        odometry.joints.publish(msg)
+        odometry.executor.spin_once(timeout_sec=0.005)
+    spin_until(odometry.executor, lambda: odometry.received['odom'] and odometry.received[
+        'odom'][-1].header.stamp == msgs[-1].header.stamp, 10.0, 'odom')
+    assert odometry.received['odom'][-1].pose.pose.position.x == pytest.approx(
+        9.9 * 0.075, rel=1e-6)  # the first message has nothing to difference against

@@ -1,0 +1,362 @@
+"""Planar motion of the swivel car: a tricycle with a variable offset steering wheel.
+
+Thesis II.E (eqs. 45-71) models the car seen from above as a tricycle whose single steering
+wheel sits at an offset contact point that moves with the swivel angle. The printed equations
+are garbled, so this module derives the model again; corrections to the thesis:
+
+* eq. 60 mixes wheel *rates* and *speeds* (``theta_f_dot h2`` against ``r theta_r_dot h0``) and
+  eq. 62 prints ``b b`` for ``b b_dot``; eqs. 63/64 are not the solutions of eq. 60 (they carry
+  ``sin(phi_car)``, i.e. depend on the world heading, which no body-frame relation can).
+* eqs. 65-68 drop the steering wheel's constraint altogether: eq. 67/68 are the plain
+  unicycle relations, so the thesis' "offset" never reaches the pose; the generalized
+  coordinate count ("five" for a list of seven) is wrong too.
+* eq. 69-71 integrate with explicit Euler; we integrate exact arcs with the mean of the
+  twists at both ends of the step (second order).
+
+Derivation. ``base_link`` is the middle of the rear axle; it moves with speed ``v`` along its x
+axis (the rear wheels do not skid sideways) and turns at ``omega``. The steering wheel touches
+the ground at ``(a, b)`` in base_link, rolls in the direction ``delta`` (the steering angle)
+and does not skid sideways. Its contact point moves, seen from the ground, with
+
+    c_dot = (v - omega b + a_dot,  omega a + b_dot)     (in base_link axes)
+
+where ``(a_dot, b_dot)`` is the contact point's motion relative to the body as the swivel
+turns. No lateral skid: ``c_dot . (-sin delta, cos delta) = 0``, so
+
+    omega (a cos delta + b sin delta) = (v + a_dot) sin delta - b_dot cos delta.
+
+With ``a_dot = b_dot = 0`` this is the steady curvature ``kappa = omega / v =
+sin delta / (a cos delta + b sin delta)``: the centre of rotation lies on the rear axle line at
+``y = 1 / kappa``, where the steering wheel's axle line crosses it. For an ordinary tricycle
+(``b = 0``) it reduces to ``omega = v tan(delta) / a``.
+
+The rear axle speed is ``v = r * mean(rear wheel rates)`` (open differential), corrected for
+the body's pitch: the wheel joints measure wheel rotation relative to the body, and the body
+pitches about the rear axle by the lift angle ``theta1(theta2)`` as the swivel turns, so the
+rolling rate on the ground is the joint rate minus ``d theta1 / dt``.
+
+The contact point jumps from one front wheel to the other as theta2 crosses zero; that jump is
+no motion of any wheel, so ``(a_dot, b_dot)`` is always the derivative on the side of zero that
+``theta2`` lies on (its lateral part is zero at theta2 = 0).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+from swivel_car_model import kinematics
+from swivel_car_model.params import SwivelCarParams
+
+_DERIVATIVE_STEP = 1e-6  # [rad] finite-difference step for the contact point's derivative
+_SINGULAR = 1e-9  # [m] smallest lever |a cos delta + b sin delta| that determines omega
+# The curvature is unbounded at theta2 = pi/2 (the centre of rotation reaches base_link), so
+# the default range of swivel_for_curvature stops this far short of it.
+_SINGULAR_GAP = 1e-3  # [rad]
+_TABLE_SIZE = 4001  # samples of the curvature table over the swivel range
+
+
+def _finite(name: str, value: float) -> float:
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f'{name} must be finite, got {value!r}')
+    return value
+
+
+def offset_tricycle_yaw_rate(v: float, a: float, b: float, a_dot: float, b_dot: float,
+                             delta: float) -> float:
+    """Yaw rate of a tricycle whose steering wheel touches the ground at a moving offset point.
+
+    Parameters
+    ----------
+    v : float
+        Speed of base_link (middle of the rear axle) along its x axis. # [m/s]
+    a, b : float
+        Steering wheel's ground contact in base_link. # [m]
+    a_dot, b_dot : float
+        Motion of that contact point relative to base_link. # [m/s]
+    delta : float
+        Rolling direction of the steering wheel in base_link, positive to the left. # [rad]
+
+    Returns
+    -------
+    float
+        Yaw rate omega, positive counter-clockwise seen from above. # [rad/s]
+
+    Raises
+    ------
+    ValueError
+        An input is not finite, or the steering wheel rolls straight towards (or away from)
+        the rear axle middle, where its constraint does not fix omega.
+    """
+    for name, value in (('v', v), ('a', a), ('b', b), ('a_dot', a_dot), ('b_dot', b_dot),
+                        ('delta', delta)):
+        _finite(name, value)
+    lever = a * math.cos(delta) + b * math.sin(delta)
+    if abs(lever) < _SINGULAR:
+        raise ValueError(
+            f'steering wheel at ({a!r}, {b!r}) rolling at {delta!r} rad passes through '
+            'base_link: the yaw rate is not determined')
+    return ((v + a_dot) * math.sin(delta) - b_dot * math.cos(delta)) / lever
+
+
+def _geometry(p: SwivelCarParams, theta2: float) -> tuple[float, float, float, float, float,
+                                                           float]:
+    """(a, b, delta, da/dtheta2, db/dtheta2, dtheta1/dtheta2) at ``theta2``.
+
+    The derivatives are taken for the wheel in contact at ``theta2``: differences at
+    ``|theta2|`` on the positive side (where the model's contact point is one wheel's up to and
+    including zero), mirrored with the car's symmetry (a and theta1 even, b and delta odd in
+    theta2), so no difference ever straddles the change of wheel.
+    """
+    sign = -1.0 if theta2 < 0.0 else 1.0
+    u = abs(theta2)
+    lo = max(u - _DERIVATIVE_STEP, 0.0)
+    hi = min(u + _DERIVATIVE_STEP, p.max_swivel_angle)
+    xs, ys = kinematics.contact_point(p, np.array([u, lo, hi]))
+    lift = kinematics.lift_angle(p, np.array([lo, hi]))
+    delta = float(kinematics.steering_angle(p, u))
+    width = hi - lo
+    return (float(xs[0]), sign * float(ys[0]), sign * delta,
+            sign * float(xs[2] - xs[1]) / width, float(ys[2] - ys[1]) / width,
+            sign * float(lift[1] - lift[0]) / width)
+
+
+def _check_swivel(p: SwivelCarParams, theta2: float) -> float:
+    theta2 = _finite('theta2', theta2)
+    if abs(theta2) > p.max_swivel_angle:
+        raise ValueError(
+            f'theta2 must be within +-{p.max_swivel_angle!r} rad, got {theta2!r}')
+    return theta2
+
+
+def body_twist(p: SwivelCarParams, theta2: float, theta2_rate: float,
+               rear_wheel_rate: float) -> tuple[float, float]:
+    """Planar twist of base_link from the measured joints.
+
+    Parameters
+    ----------
+    p : SwivelCarParams
+    theta2 : float
+        Swivel angle. # [rad]
+    theta2_rate : float
+        Swivel rate. # [rad/s]
+    rear_wheel_rate : float
+        Mean of the two rear wheel joint rates (relative to the body). # [rad/s]
+
+    Returns
+    -------
+    (v, omega) : tuple of float
+        Forward speed of base_link # [m/s] and its yaw rate # [rad/s].
+
+    Raises
+    ------
+    ValueError
+        Non-finite input, theta2 beyond the joint limit, or the singular swivel angle at which
+        the steering wheel's axle line passes through base_link.
+    """
+    theta2 = _check_swivel(p, theta2)
+    theta2_rate = _finite('theta2_rate', theta2_rate)
+    rear_wheel_rate = _finite('rear_wheel_rate', rear_wheel_rate)
+    a, b, delta, da, db, dlift = _geometry(p, theta2)
+    v = p.r * (rear_wheel_rate - dlift * theta2_rate)
+    omega = offset_tricycle_yaw_rate(v, a, b, da * theta2_rate, db * theta2_rate, delta)
+    return v, omega
+
+
+def curvature_for_swivel(p: SwivelCarParams, theta2: float) -> float:
+    """Steady path curvature of base_link, omega / v, at a constant swivel angle.
+
+    Returns
+    -------
+    float
+        Curvature, positive turning left. # [1/m]
+    """
+    theta2 = _check_swivel(p, theta2)
+    a, b, delta, _, _, _ = _geometry(p, theta2)
+    return offset_tricycle_yaw_rate(1.0, a, b, 0.0, 0.0, delta)
+
+
+@functools.lru_cache(maxsize=16)
+def _curvature_table(p: SwivelCarParams, limit: float) -> tuple[np.ndarray, np.ndarray, bool]:
+    """|curvature| sampled over [0, limit] (strictly increasing), for inverting it fast, and
+    whether positive swivel angles turn left (from the geometry, not a guess)."""
+    angles = np.linspace(0.0, limit, _TABLE_SIZE)
+    xs, ys = kinematics.contact_point(p, angles)
+    delta = np.asarray(kinematics.steering_angle(p, angles))
+    lever = xs * np.cos(delta) + ys * np.sin(delta)
+    if np.any(np.abs(lever) < _SINGULAR):
+        raise ValueError(f'the curvature is unbounded within +-{limit!r} rad')
+    curvature = np.sin(delta) / lever
+    magnitude = np.abs(curvature)
+    if np.any(np.diff(magnitude) <= 0.0):
+        raise ValueError('the curvature does not grow monotonically with |theta2| for this '
+                         'geometry; swivel_for_curvature needs it to')
+    return angles, magnitude, bool(curvature[-1] > 0.0)
+
+
+def max_curvature(p: SwivelCarParams, swivel_limit: float) -> float:
+    """Largest |curvature| reachable with ``|theta2| <= swivel_limit``. # [1/m]
+
+    The curvature grows monotonically with |theta2|, so it is the curvature at the limit.
+    """
+    swivel_limit = _check_swivel(p, swivel_limit)
+    if swivel_limit <= 0.0:
+        raise ValueError(f'swivel_limit must be > 0, got {swivel_limit!r}')
+    return abs(curvature_for_swivel(p, swivel_limit))
+
+
+def swivel_for_curvature(p: SwivelCarParams, curvature: float,
+                         swivel_limit: float | None = None) -> float:
+    """Swivel angle that makes base_link follow a path of the given curvature.
+
+    Interpolation in a cached table of the curvature (per parameters and limit), then one
+    Newton step on the exact relation: accurate to ~1e-12 rad at the cost of one evaluation,
+    fast enough for every control period.
+
+    Parameters
+    ----------
+    p : SwivelCarParams
+    curvature : float
+        Wanted curvature, positive turning left. # [1/m]
+    swivel_limit : float, optional
+        Largest |theta2| allowed; default ``p.max_swivel_angle``, but at most
+        ``pi/2 - 1e-3`` where the curvature is finite. # [rad]
+
+    Returns
+    -------
+    float
+        theta2 # [rad]; the swivel turns right-handed for a right turn (negative curvature).
+
+    Raises
+    ------
+    ValueError
+        Non-finite curvature, or one beyond ``max_curvature(p, swivel_limit)``.
+    """
+    curvature = _finite('curvature', curvature)
+    if swivel_limit is None:
+        limit = min(p.max_swivel_angle, math.pi / 2 - _SINGULAR_GAP)
+    else:
+        limit = float(_check_swivel(p, swivel_limit))
+    if curvature == 0.0:
+        return 0.0
+    angles, magnitudes, positive_turns_left = _curvature_table(p, limit)
+    wanted = abs(curvature)
+    if wanted > magnitudes[-1]:
+        raise ValueError(
+            f'curvature {curvature!r} 1/m is beyond the reachable +-{magnitudes[-1]!r} 1/m '
+            f'(swivel limit {limit!r} rad)')
+    i = int(np.clip(np.searchsorted(magnitudes, wanted), 1, len(angles) - 1))
+    slope = (magnitudes[i] - magnitudes[i - 1]) / (angles[i] - angles[i - 1])
+    guess = float(angles[i - 1] + (wanted - magnitudes[i - 1]) / slope)
+    magnitude = guess + (wanted - abs(curvature_for_swivel(p, guess))) / slope
+    magnitude = min(max(magnitude, 0.0), limit)
+    return float(magnitude if (curvature > 0.0) == positive_turns_left else -magnitude)
+
+
+def wheel_rate_for_speed(p: SwivelCarParams, v: float) -> float:
+    """Drive rate at the wheels for a forward speed of base_link. # [rad/s]
+
+    The single drive motor turns both axles' differential carriers at the same rate, the mean
+    of each axle's wheel rates; the rear carrier rate times r is base_link's speed.
+    """
+    return _finite('v', v) / p.r
+
+
+class OffsetTricycleOdometry:
+    """Pose of base_link in the odometry frame, integrated from the measured joints.
+
+    Each ``update`` computes the body twist from the new measurement (``body_twist``), then
+    moves along the exact arc of the mean of the previous and the new twist (second order,
+    exact on circles driven at constant speed).
+
+    Parameters
+    ----------
+    p : SwivelCarParams
+    """
+
+    def __init__(self, p: SwivelCarParams) -> None:
+        self._p = p
+        self.reset()
+
+    def reset(self) -> None:
+        """Pose to zero and forget the last twist."""
+        self.x = 0.0  # [m]
+        self.y = 0.0  # [m]
+        self.yaw = 0.0  # [rad], wrapped to (-pi, pi]
+        self.v = 0.0  # [m/s]
+        self.omega = 0.0  # [rad/s]
+        self._have_twist = False
+
+    def set_pose(self, x: float, y: float, yaw: float) -> None:
+        """Set the pose; the twist is kept. # [m], [m], [rad]"""
+        x, y, yaw = _finite('x', x), _finite('y', y), _finite('yaw', yaw)
+        self.x, self.y, self.yaw = x, y, _wrap(yaw)
+
+    def update(self, theta2: float, theta2_rate: float, rear_wheel_rate: float,
+               dt: float, rear_wheel_rate_difference: float | None = None
+               ) -> tuple[float, float]:
+        """Advance by ``dt`` with a new joint measurement.
+
+        Parameters
+        ----------
+        theta2, theta2_rate, rear_wheel_rate : float
+            As for ``body_twist``. # [rad], [rad/s], [rad/s]
+        dt : float
+            Time since the previous measurement, >= 0. # [s]
+        rear_wheel_rate_difference : float, optional
+            Right minus left rear wheel rate. # [rad/s]
+            If given, the yaw rate comes from the rear axle, ``r * difference / (2 h)`` (the
+            rear wheels roll without skidding on either side of base_link), instead of from
+            the steering wheel's constraint; the speed still comes from ``body_twist``.
+
+        Returns
+        -------
+        (v, omega) : the new twist. # [m/s], [rad/s]
+
+        Raises
+        ------
+        ValueError
+            Bad input (see ``body_twist``) or a negative or non-finite dt; the state is
+            unchanged.
+        """
+        dt = _finite('dt', dt)
+        if dt < 0.0:
+            raise ValueError(f'dt must be >= 0, got {dt!r}')
+        v, omega = body_twist(self._p, theta2, theta2_rate, rear_wheel_rate)
+        if rear_wheel_rate_difference is not None:
+            omega = self._p.r * _finite('rear_wheel_rate_difference',
+                                        rear_wheel_rate_difference) / (2.0 * self._p.h)
+        if self._have_twist:
+            v_mean, omega_mean = 0.5 * (v + self.v), 0.5 * (omega + self.omega)
+        else:
+            v_mean, omega_mean = v, omega
+        dx, dy, dyaw = arc_step(v_mean, omega_mean, self.yaw, dt)
+        self.x += dx
+        self.y += dy
+        self.yaw = _wrap(self.yaw + dyaw)
+        self.v, self.omega, self._have_twist = v, omega, True
+        return v, omega
+
+
+def arc_step(v: float, omega: float, yaw: float, dt: float) -> tuple[float, float, float]:
+    """Displacement (dx, dy, dyaw) in the fixed frame along the exact arc of a constant twist.
+
+    # [m], [m], [rad] from v [m/s], omega [rad/s], yaw [rad], dt [s]
+    """
+    dyaw = omega * dt
+    if abs(dyaw) < 1e-9:
+        # Second-order series of the arc: a straight line turned by half the heading change.
+        mid = yaw + 0.5 * dyaw
+        return v * dt * math.cos(mid), v * dt * math.sin(mid), dyaw
+    radius = v / omega
+    return (radius * (math.sin(yaw + dyaw) - math.sin(yaw)),
+            -radius * (math.cos(yaw + dyaw) - math.cos(yaw)), dyaw)
+
+
+def _wrap(angle: float) -> float:
+    """Angle wrapped to (-pi, pi]. # [rad]"""
+    wrapped = math.remainder(angle, 2.0 * math.pi)
+    return math.pi if wrapped == -math.pi else wrapped

@@ -1,0 +1,199 @@
+"""Tests of the offset-tricycle planar model and its odometry integrator."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from swivel_car_model import kinematics, planar
+from swivel_car_model.params import SwivelCarParams
+
+P = SwivelCarParams()
+LIMIT = 1.4  # [rad] a swivel range well clear of the singular pi/2
+
+angles = st.floats(-LIMIT, LIMIT, allow_nan=False)
+rates = st.floats(-3.0, 3.0, allow_nan=False)
+
+
+@settings(deadline=None)
+@given(v=st.floats(-2.0, 2.0), a=st.floats(0.1, 1.0), delta=st.floats(-1.2, 1.2))
+def test_without_offset_it_is_the_plain_tricycle(v, a, delta):
+    omega = planar.offset_tricycle_yaw_rate(v, a, 0.0, 0.0, 0.0, delta)
+    assert omega == pytest.approx(v * math.tan(delta) / a, rel=1e-9, abs=1e-12)
+
+
+def test_yaw_rate_rejects_the_singular_and_non_finite():
+    with pytest.raises(ValueError, match='not determined'):
+        planar.offset_tricycle_yaw_rate(1.0, 0.0, 0.0, 0.0, 0.0, 0.3)
+    with pytest.raises(ValueError, match='finite'):
+        planar.offset_tricycle_yaw_rate(math.nan, 0.4, 0.0, 0.0, 0.0, 0.3)
+
+
+def test_straight_at_zero_swivel():
+    v, omega = planar.body_twist(P, 0.0, 0.0, 2.0)
+    assert v == pytest.approx(2.0 * P.r)
+    assert omega == 0.0
+
+
+def test_positive_swivel_turns_right_for_positive_phi():
+    assert planar.curvature_for_swivel(P, 0.5) < 0.0
+    assert planar.curvature_for_swivel(P, -0.5) == pytest.approx(
+        -planar.curvature_for_swivel(P, 0.5))
+    flipped = SwivelCarParams(phi=-math.pi / 3)
+    assert planar.curvature_for_swivel(flipped, 0.5) > 0.0
+
+
+def test_curvature_grows_monotonically_with_the_swivel():
+    curvature = [abs(planar.curvature_for_swivel(P, t)) for t in np.linspace(0.0, 1.56, 300)]
+    assert np.all(np.diff(curvature) > 0.0)
+
+
+@settings(deadline=None)
+@given(theta2=angles)
+def test_swivel_for_curvature_inverts_curvature_for_swivel(theta2):
+    curvature = planar.curvature_for_swivel(P, theta2)
+    assert planar.swivel_for_curvature(P, curvature, LIMIT) == pytest.approx(theta2, abs=1e-8)
+
+
+def test_swivel_for_curvature_rejects_bad_input():
+    reachable = planar.max_curvature(P, LIMIT)
+    with pytest.raises(ValueError, match='beyond'):
+        planar.swivel_for_curvature(P, 1.01 * reachable, LIMIT)
+    with pytest.raises(ValueError, match='finite'):
+        planar.swivel_for_curvature(P, math.inf)
+    with pytest.raises(ValueError):
+        planar.swivel_for_curvature(P, 1.0, swivel_limit=2.0)
+    assert planar.swivel_for_curvature(P, 0.0) == 0.0
+
+
+def test_body_twist_rejects_bad_input():
+    for args in ((math.nan, 0.0, 1.0), (0.1, math.inf, 1.0), (0.1, 0.0, -math.inf),
+                 (P.max_swivel_angle + 0.01, 0.0, 1.0)):
+        with pytest.raises(ValueError):
+            planar.body_twist(P, *args)
+
+
+def test_swivel_sweep_without_rolling_does_not_move_base_link():
+    # The rear wheels stand still on the ground; their joints see the body pitch back.
+    theta2, rate = 0.6, 0.4
+    joint_rate = kinematics.lift_angle_derivative(P, theta2) * rate
+    v, _ = planar.body_twist(P, theta2, rate, joint_rate)
+    assert v == pytest.approx(0.0, abs=1e-9)
+
+
+def _drive(odometry, swivel_of_t, wheel_rate_of_t, duration, dt):
+    """Feed the odometry a trajectory; return the world positions of the contact point."""
+    contacts, headings, sides = [], [], []
+    for k in range(int(round(duration / dt)) + 1):
+        t = k * dt
+        theta2 = swivel_of_t(t)
+        rate = (swivel_of_t(t + 1e-6) - swivel_of_t(t - 1e-6)) / 2e-6
+        odometry.update(theta2, rate, wheel_rate_of_t(t), dt if k else 0.0)
+        a, b = kinematics.contact_point(P, theta2)
+        c, s = math.cos(odometry.yaw), math.sin(odometry.yaw)
+        contacts.append((odometry.x + c * a - s * b, odometry.y + s * a + c * b))
+        headings.append(odometry.yaw + kinematics.steering_angle(P, theta2))
+        sides.append(theta2 >= 0.0)
+    return np.array(contacts), np.array(headings), np.array(sides)
+
+
+def test_steering_wheel_never_skids_while_the_swivel_moves():
+    """The pose integrated from body_twist moves the steering wheel's contact point only
+    along its rolling direction (the constraint the model is built on), also while the swivel
+    turns and changes sides through zero."""
+    odometry = planar.OffsetTricycleOdometry(P)
+    dt = 1e-3
+    contacts, headings, sides = _drive(odometry, lambda t: 1.2 * math.sin(0.8 * t),
+                                       lambda t: 4.0 + 2.0 * math.cos(t), 6.0, dt)
+    velocity = np.gradient(contacts, dt, axis=0)
+    lateral = -velocity[:, 0] * np.sin(headings) + velocity[:, 1] * np.cos(headings)
+    # Where the contact passes to the other front wheel the difference quotient is no velocity.
+    same_wheel = (sides[:-2] == sides[1:-1]) & (sides[1:-1] == sides[2:])
+    assert np.count_nonzero(~same_wheel) <= 8
+    lateral = lateral[1:-1][same_wheel]
+    speed = np.linalg.norm(velocity[1:-1][same_wheel], axis=1)
+    assert np.max(np.abs(lateral)) < 1e-4 * np.max(speed)
+
+
+@pytest.mark.parametrize('theta2', [0.2, -0.7, 1.3])
+def test_constant_swivel_drives_a_closed_circle(theta2):
+    odometry = planar.OffsetTricycleOdometry(P)
+    wheel_rate = 3.0  # [rad/s]
+    v, omega = planar.body_twist(P, theta2, 0.0, wheel_rate)
+    period = 2.0 * math.pi / abs(omega)
+    steps = 1000
+    positions = []
+    for k in range(steps + 1):
+        odometry.update(theta2, 0.0, wheel_rate, period / steps if k else 0.0)
+        positions.append((odometry.x, odometry.y))
+    positions = np.array(positions)
+    radius = 1.0 / planar.curvature_for_swivel(P, theta2)
+    # Centre of rotation on the rear axle line at y = 1 / curvature.
+    assert np.allclose(np.hypot(positions[:, 0], positions[:, 1] - radius), abs(radius),
+                       atol=1e-9)
+    assert positions[-1] == pytest.approx([0.0, 0.0], abs=1e-9)
+    assert abs(odometry.yaw) < 1e-9
+
+
+def test_arc_step_matches_fine_integration():
+    v, omega, yaw, dt = 0.7, 1.3, 2.9, 0.4
+    dx, dy, dyaw = planar.arc_step(v, omega, yaw, dt)
+    n = 20000
+    x = y = 0.0
+    heading = yaw
+    for _ in range(n):
+        x += v * math.cos(heading + 0.5 * omega * dt / n) * dt / n
+        y += v * math.sin(heading + 0.5 * omega * dt / n) * dt / n
+        heading += omega * dt / n
+    assert (dx, dy, dyaw) == pytest.approx((x, y, omega * dt), abs=1e-9)
+    assert planar.arc_step(0.5, 0.0, 0.3, 2.0) == pytest.approx(
+        (math.cos(0.3), math.sin(0.3), 0.0))
+
+
+def test_odometry_reset_set_pose_and_wrap():
+    odometry = planar.OffsetTricycleOdometry(P)
+    odometry.set_pose(1.0, -2.0, 3.0 * math.pi)
+    assert (odometry.x, odometry.y, odometry.yaw) == pytest.approx((1.0, -2.0, math.pi))
+    odometry.update(-0.8, 0.0, 5.0, 0.0)
+    for _ in range(300):
+        odometry.update(-0.8, 0.0, 5.0, 0.01)
+        assert -math.pi < odometry.yaw <= math.pi
+    odometry.reset()
+    assert (odometry.x, odometry.y, odometry.yaw, odometry.v) == (0.0, 0.0, 0.0, 0.0)
+
+
+@settings(deadline=None, max_examples=30)
+@given(bad=st.sampled_from([math.nan, math.inf, -math.inf]),
+       slot=st.integers(0, 3))
+def test_odometry_bad_input_changes_nothing(bad, slot):
+    odometry = planar.OffsetTricycleOdometry(P)
+    odometry.update(0.3, 0.0, 2.0, 0.0)
+    odometry.update(0.3, 0.0, 2.0, 0.1)
+    before = (odometry.x, odometry.y, odometry.yaw, odometry.v, odometry.omega)
+    args = [0.3, 0.0, 2.0, 0.1]
+    args[slot] = bad
+    with pytest.raises(ValueError):
+        odometry.update(*args)
+    with pytest.raises(ValueError):
+        odometry.update(0.3, 0.0, 2.0, -0.01)
+    with pytest.raises(ValueError):
+        odometry.set_pose(bad, 0.0, 0.0)
+    assert (odometry.x, odometry.y, odometry.yaw, odometry.v, odometry.omega) == before
+
+
+@pytest.mark.parametrize('theta2', [-1e-7, -1e-12, 0.0, 1e-12, 1e-7])
+def test_twist_is_smooth_through_zero_swivel(theta2):
+    """Near zero the contact changes wheel; the twist must not see that jump as motion."""
+    v, omega = planar.body_twist(P, theta2, 0.01, 5.0)
+    assert v == pytest.approx(5.0 * P.r, rel=1e-3)
+    assert abs(omega) < 0.01
+
+
+def test_yaw_rate_from_the_rear_axle():
+    odometry = planar.OffsetTricycleOdometry(P)
+    v, omega = odometry.update(0.5, 0.0, 4.0, 0.0, rear_wheel_rate_difference=2.0)
+    assert v == pytest.approx(planar.body_twist(P, 0.5, 0.0, 4.0)[0])
+    assert omega == pytest.approx(P.r * 2.0 / (2.0 * P.h))
+    with pytest.raises(ValueError):
+        odometry.update(0.5, 0.0, 4.0, 0.01, rear_wheel_rate_difference=math.nan)

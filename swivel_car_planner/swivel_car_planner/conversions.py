@@ -1,0 +1,46 @@
+"""Conversions between swivel_car_msgs and the planner core's types."""
+
+from __future__ import annotations
+
+import math
+
+from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan as ClimbPlanMsg
+
+from swivel_car_planner.core import ClimbPlan, ClimbRequest, Outcome
+
+
+def request_from(message, with_time_allowance: bool) -> ClimbRequest:
+    """A core request from a srv/ClimbStep request or an action/ClimbStep goal."""
+    return ClimbRequest(
+        step_height=float(message.step_height), step_distance=float(message.step_distance),
+        step_yaw=float(message.step_yaw), plan_only=bool(message.plan_only),
+        time_allowance=float(message.time_allowance) if with_time_allowance else 0.0)
+
+
+def plan_to_msg(plan: ClimbPlan) -> ClimbPlanMsg:
+    msg = ClimbPlanMsg()
+    for name in ('swivel_angle', 'lift_angle', 'wheel_clearance', 'approach_distance',
+                 'approach_heading', 'peak_torque', 'energy', 'max_scalable_step',
+                 'tip_over_margin', 'interference_margin', 'duration'):
+        setattr(msg, name, float(getattr(plan, name)))
+    msg.procedure = int(plan.procedure)
+    return msg
+
+
+def outcome_to_msg(outcome: Outcome) -> ClimbOutcome:
+    return ClimbOutcome(
+        duration=float(outcome.duration), peak_torque=float(outcome.peak_torque),
+        energy=float(outcome.energy), max_pitch=float(outcome.max_pitch),
+        distance_travelled=float(outcome.distance_travelled))
+
+
+def roll_pitch(x: float, y: float, z: float, w: float) -> tuple[float, float]:
+    """Roll and pitch of a quaternion (REP-103 fixed-axis roll, pitch, yaw). # [rad]"""
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+    return roll, pitch
+
+
+def yaw_of(x: float, y: float, z: float, w: float) -> float:
+    """Yaw of a quaternion. # [rad]"""
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))

@@ -1,0 +1,92 @@
+"""The planner's tuning, one validated frozen dataclass (filled from ROS parameters)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+
+def _field(default: float, description: str) -> Any:
+    return field(default=default, metadata={'description': description})
+
+
+@dataclass(frozen=True)
+class PlannerConfig:
+    """Margins, limits, speeds and monitor thresholds of the climb.
+
+    Each field's metadata ``description`` (with its unit) is also its ROS parameter's.
+
+    Raises
+    ------
+    ValueError
+        A field is not finite or out of its range; the message names the field.
+    """
+
+    tip_over_margin: float = _field(
+        0.15, 'margin the plan keeps on the tip-over rule (pi - phi)/2 - theta1 [rad]')
+    clearance_margin: float = _field(
+        0.01, 'lifted wheel lowest point above the step top [m]')
+    torque_limit: float = _field(
+        30.0, 'peak torque of the swivel actuator (the controller max_torque) [N m]')
+    max_step_distance: float = _field(3.0, 'farthest step edge a request may name [m]')
+    max_step_yaw: float = _field(1.0, 'largest |step_yaw| the planner accepts [rad]')
+    lead_margin: float = _field(
+        0.03, 'lifted wheel past the edge while the other front wheel is still clear [m]')
+    lift_gap: float = _field(0.03, 'lifted wheel front to the riser when the lift starts [m]')
+    max_lead_angle: float = _field(0.8, 'largest approach angle to the step normal [rad]')
+    approach_speed: float = _field(3.0, 'drive speed at the wheels while approaching [rad/s]')
+    climb_speed: float = _field(2.0, 'drive speed at the wheels while climbing [rad/s]')
+    rear_speed: float = _field(
+        6.5, 'drive speed at the wheels while the rear axle climbs; its momentum helps the '
+        'rear wheels up the riser [rad/s]')
+    swivel_rate: float = _field(0.6, 'swivel rate limit for lift and set-down [rad/s]')
+    max_steer: float = _field(0.35, 'largest steering angle used to align [rad]')
+    heading_gain: float = _field(1.5, 'steering angle per heading error [1]')
+    align_tolerance: float = _field(0.12, 'heading error allowed when the lift starts [rad]')
+    swivel_tolerance: float = _field(0.04, 'swivel counts as at its target within this [rad]')
+    settle_rate: float = _field(0.05, 'swivel counts as at rest below this rate [rad/s]')
+    settle_time: float = _field(0.3, 'swivel at its target and at rest this long [s]')
+    rear_slip_allowance: float = _field(
+        0.25, 'odometry past the edge beyond rest_margin with the car still pitched: the '
+        'rear axle failed to climb [m]')
+    rear_step_limit: float = _field(
+        0.05, 'highest step the rear axle climbs by traction (measured in the sim); higher '
+        'steps are refused as unreachable for the whole car [m]')
+    rest_margin: float = _field(
+        0.05, 'rear wheel contacts past the edge to call the climb done [m]')
+    level_tolerance: float = _field(
+        0.12, 'largest |pitch| on top of the step to call the climb done [rad]')
+    bias_gain: float = _field(
+        2.0, 'outer loop: command bias per remaining swivel error and second [1/s]')
+    max_bias: float = _field(0.6, 'outer loop: largest command bias [rad]')
+    max_swivel_command: float = _field(1.2, 'largest |swivel command| sent [rad]')
+    stall_progress: float = _field(
+        0.01, 'the swivel must close on its goal by this much every stall_time [rad]')
+    stall_time: float = _field(4.0, 'swivel making no headway this long: stall [s]')
+    slip_yaw_tolerance: float = _field(
+        0.25, 'IMU and odometry headings parting this far: the wheels slip [rad]')
+    no_progress_time: float = _field(4.0, 'window of the no-progress monitor [s]')
+    min_progress: float = _field(0.01, 'path length the car must make in that window [m]')
+    pitch_abort_margin: float = _field(
+        0.08, 'abort when the nose-up pitch comes this near the tip-over rule [rad]')
+    time_allowance: float = _field(60.0, 'default climb time limit, sim time [s]')
+
+    def __post_init__(self) -> None:
+        for item in fields(self):
+            value = getattr(self, item.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                    or not math.isfinite(value):
+                raise ValueError(f'{item.name} must be a finite number, got {value!r}')
+            if value < 0.0:
+                raise ValueError(f'{item.name} must be >= 0, got {value!r}')
+        for name in ('torque_limit', 'max_step_distance', 'max_step_yaw', 'max_lead_angle',
+                     'approach_speed', 'climb_speed', 'rear_speed', 'swivel_rate', 'max_steer',
+                     'max_swivel_command', 'swivel_tolerance', 'settle_rate', 'stall_progress',
+                     'stall_time', 'slip_yaw_tolerance', 'no_progress_time', 'min_progress',
+                     'time_allowance'):
+            if getattr(self, name) <= 0.0:
+                raise ValueError(f'{name} must be > 0, got {getattr(self, name)!r}')
+        for name in ('max_step_yaw', 'max_lead_angle'):
+            if getattr(self, name) >= math.pi / 2:
+                raise ValueError(f'{name} must be below pi/2, got {getattr(self, name)!r}')

@@ -1,0 +1,194 @@
+"""Feasibility check and climb plan, from the model library (swivel_car_model).
+
+The model supplies every thesis quantity (swivel angle for a step, lift angle, the tip-over
+rule eq. 72, the interference rule eq. 75, peak torque and energy, the pose change that the
+swivel causes). What this module adds is the approach geometry of the active-lift procedure,
+derived here rather than taken from thesis eqs. 76-85 (see "Approach geometry" below and the
+package README for why).
+
+Approach geometry
+-----------------
+The car meets the edge at a lead angle psi to the edge's normal, so that one front wheel
+(the lifted one) is over the step while the other is still short of the riser. A wheel of
+radius r standing on the ground touches an edge of height hs when its contact point is
+``a = sqrt(r^2 - (r - min(hs, r))^2)`` from the edge. The two front contacts are 2h apart
+along the axle, so along the normal they differ by ``2 h sin(psi)``. Asking the lifted wheel
+to be ``lead_margin`` past the edge while the other is ``a + lead_margin`` short of it gives::
+
+    sin(psi_lead) = (a + 2 lead_margin) / (2 h)
+
+Thesis eqs. 76-85 instead chain an arc of the lifted wheel onto the edge at a final angle
+gamma; their printed forms are inconsistent (eq. 76 uses 2 l cos(phi) where the wheelbase is
+2 l cos(phi/2); eq. 84 defines d_2 while eq. 85 returns d; eq. 85's tan(gamma) does not follow
+from the sine law of eq. 84), so the planner does not use them. The lead angle is never below
+the model's minimum approach angle (``climbing.min_approach_angle_for_step``, thesis eqs.
+92-100 with exact wheel discs), the bound the thesis derives for phi < 0; for phi > 0 the
+derivation above is the larger one.
+
+Lifting the wheel turns and shifts the car (thesis II.E; ``dynamics.swivel_pose_drift``): the
+approach aims at ``psi_lead - drift_yaw`` so that the car meets the edge at ``psi_lead``
+once the wheel is up, and starts the lift far enough back that the drift does not push the
+rising wheel into the riser.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from swivel_car_model import climbing, dynamics, kinematics
+from swivel_car_model.params import SwivelCarParams
+
+from swivel_car_planner.core.codes import ErrorCode
+from swivel_car_planner.core.config import PlannerConfig
+from swivel_car_planner.core.request import ClimbRequest
+
+PROCEDURE_ACTIVE_LIFT = 0  # ClimbPlan.PROCEDURE_ACTIVE_LIFT
+PROCEDURE_SEMI_ACTIVE = 1  # ClimbPlan.PROCEDURE_SEMI_ACTIVE
+
+
+class PlanError(Exception):
+    """The request cannot be planned; ``code`` says why (an ``ErrorCode``)."""
+
+    def __init__(self, code: ErrorCode, message: str) -> None:
+        super().__init__(message)
+        self.code = code
+        self.message = message
+
+
+@dataclass(frozen=True)
+class ClimbPlan:
+    """Everything the climb needs, computed before moving.
+
+    The first fields mirror swivel_car_msgs/ClimbPlan; the rest drive the state machine.
+    """
+
+    procedure: int
+    swivel_angle: float  # [rad] signed theta2 of the lift
+    lift_angle: float  # [rad] theta1 at that swivel angle
+    wheel_clearance: float  # [m] lifted wheel's lowest point above the step top
+    approach_distance: float  # [m] front axle contact to the edge, along the heading, at lift
+    approach_heading: float  # [rad] car heading to the edge's normal when the lift starts
+    peak_torque: float  # [N m] predicted
+    energy: float  # [J] predicted
+    max_scalable_step: float  # [m]
+    tip_over_margin: float  # [rad]
+    interference_margin: float  # [m]
+    duration: float  # [s] predicted
+    lifted_side: int  # +1: left front wheel lifted (theta2 > 0), -1: right
+    lead_angle: float  # [rad] heading to the normal, signed, once the wheel is up
+    lead_distance: float  # [m] lifted wheel's contact to the edge (along the normal) at lift
+    second_swivel_angle: float  # [rad] swivel that holds the second wheel clearance_margin up
+    step_height: float  # [m]
+
+
+def lead_angle(p: SwivelCarParams, config: PlannerConfig, step_height: float) -> float:
+    """Smallest |heading to the edge's normal| at which the lifted wheel gets over the edge
+    before the other front wheel meets the riser (module docstring). # [rad]
+
+    Raises
+    ------
+    PlanError
+        The front wheels are too close together for any angle below ``max_lead_angle``.
+    """
+    sink = p.r - min(step_height, p.r)
+    reach = math.sqrt(p.r ** 2 - sink ** 2)
+    sine = (reach + 2.0 * config.lead_margin) / (2.0 * p.h)
+    if sine >= math.sin(config.max_lead_angle):
+        raise PlanError(ErrorCode.WHEEL_INTERFERENCE,
+                        f'the front wheels (2h = {2 * p.h:.3f} m) are too close together to '
+                        f'put one over a {step_height:.3f} m step before the other meets it '
+                        f'below a lead angle of {config.max_lead_angle:.2f} rad')
+    return math.asin(sine)
+
+
+def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest) -> ClimbPlan:
+    """Check feasibility and plan the climb of a validated request.
+
+    Raises
+    ------
+    PlanError
+        With ``UNREACHABLE_HEIGHT``, ``TIP_OVER``, ``WHEEL_INTERFERENCE``, ``TORQUE_LIMIT``
+        or ``INVALID_REQUEST`` (the step is too close to align) and a message.
+    """
+    height = request.step_height
+    max_step, _ = kinematics.max_scalable_step(p, respect_tip_over=True)
+    reach, _ = kinematics.max_scalable_step(p, respect_tip_over=False)
+    wanted = height + config.clearance_margin
+    try:
+        theta2 = float(kinematics.swivel_for_step(p, wanted, respect_tip_over=False))
+    except ValueError as error:
+        raise PlanError(ErrorCode.UNREACHABLE_HEIGHT,
+                        f'a {height:.3f} m step plus {config.clearance_margin:.3f} m clearance '
+                        f'is beyond the lifted wheel\'s reach ({reach:.3f} m): {error}') \
+            from error
+    theta1 = float(kinematics.lift_angle(p, theta2))
+    tip_margin = float(kinematics.tip_over_margin(p, theta1))
+    if tip_margin < config.tip_over_margin:
+        raise PlanError(ErrorCode.TIP_OVER,
+                        f'lifting the wheel over {height:.3f} m pitches the car to '
+                        f'{theta1:.3f} rad, {tip_margin:.3f} rad from tipping over '
+                        f'(eq. 72); the planner wants {config.tip_over_margin:.3f} rad; the '
+                        f'largest step that keeps the rule is {max_step:.3f} m')
+    interference = float(kinematics.interference_margin(p, theta1))
+    if interference <= 0.0:
+        raise PlanError(ErrorCode.WHEEL_INTERFERENCE,
+                        f'at the lift angle {theta1:.3f} rad the front wheel shaft reaches the '
+                        f'rear wheels (eq. 75 margin {interference:.3f} m)')
+    peak_torque, energy = (float(v) for v in dynamics.climb_torque_energy(p, height))
+    if peak_torque > config.torque_limit:
+        raise PlanError(ErrorCode.TORQUE_LIMIT,
+                        f'the climb needs a peak swivel torque of {peak_torque:.2f} N m, above '
+                        f'the actuator limit of {config.torque_limit:.2f} N m')
+    if height > config.rear_step_limit:
+        raise PlanError(ErrorCode.UNREACHABLE_HEIGHT,
+                        f'the front wheels could lift over {height:.3f} m, but the rear axle '
+                        f'has no lift mechanism and climbs only {config.rear_step_limit:.3f} m '
+                        f'by traction (parameter rear_step_limit)')
+
+    # Lift the wheel on the side that leads already, so the car turns the least.
+    initial_heading = -request.step_yaw  # [rad] car heading to the edge's normal
+    side = 1 if initial_heading <= 0.0 else -1
+    # Never below the model's minimum approach angle (thesis eqs. 92-100, exact wheel discs;
+    # the bound the thesis derives for phi < 0, and a check of the derivation above).
+    psi_lead = -side * max(lead_angle(p, config, height),
+                           float(climbing.min_approach_angle_for_step(p, height)))
+    signed_theta2 = side * abs(theta2)
+    drift_x, drift_y, drift_yaw = (
+        float(v) for v in dynamics.swivel_pose_drift(p, 0.0, signed_theta2))
+    approach_heading = psi_lead - drift_yaw
+    drift_normal = (drift_x * math.cos(approach_heading)
+                    - drift_y * math.sin(approach_heading))
+    lead_distance = p.r + config.lift_gap + max(0.0, drift_normal)
+    axle_normal = lead_distance + p.h * abs(math.sin(approach_heading))
+    approach_distance = axle_normal / math.cos(approach_heading)
+
+    # Aligning turns on an arc of radius >= wheelbase / tan(max_steer); give it room.
+    turn_radius = p.wheelbase / math.tan(config.max_steer)
+    align_run = 1.5 * turn_radius * abs(math.sin(approach_heading) - math.sin(initial_heading))
+    available = request.step_distance * math.cos(request.step_yaw)
+    if not request.plan_only and available < axle_normal + align_run:
+        raise PlanError(ErrorCode.INVALID_REQUEST,
+                        f'the step is too close: aligning to {approach_heading:.2f} rad and '
+                        f'lifting needs the edge at least {axle_normal + align_run:.2f} m '
+                        f'ahead of the front axle (along its normal), it is {available:.2f} m')
+
+    v_approach = config.approach_speed * p.r  # [m/s]
+    v_climb = config.climb_speed * p.r  # [m/s]
+    cos_lead = math.cos(psi_lead)
+    duration = (max(0.0, available - axle_normal) / max(0.5, cos_lead) / v_approach
+                + 2.0 * abs(theta2) / config.swivel_rate + config.settle_time
+                + (lead_distance + config.lead_margin) / cos_lead / v_climb
+                + (p.wheelbase + 2.0 * p.h * abs(math.sin(psi_lead)) + config.rest_margin)
+                / cos_lead / v_climb)
+    return ClimbPlan(
+        procedure=PROCEDURE_ACTIVE_LIFT if p.phi > 0.0 else PROCEDURE_SEMI_ACTIVE,
+        swivel_angle=signed_theta2, lift_angle=theta1,
+        wheel_clearance=float(kinematics.lifted_wheel_lowest_height(p, theta2)) - height,
+        approach_distance=approach_distance, approach_heading=approach_heading,
+        peak_torque=peak_torque, energy=energy, max_scalable_step=float(max_step),
+        tip_over_margin=tip_margin, interference_margin=interference, duration=duration,
+        lifted_side=side, lead_angle=psi_lead, lead_distance=lead_distance,
+        second_swivel_angle=-side * float(kinematics.swivel_for_step(
+            p, config.clearance_margin, respect_tip_over=False)),
+        step_height=height)

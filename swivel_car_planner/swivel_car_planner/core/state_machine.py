@@ -1,0 +1,437 @@
+"""The climb as a pure state machine: observations in, swivel commands and feedback out.
+
+One ``update`` per control cycle (the node calls it from a sim-time timer). Steps (and the
+action phase each one reports)::
+
+    APPROACH         drive to the lift point, steering to the planned heading   APPROACH
+    LIFT             stop; swivel to the plan's angle: the leading front wheel
+                     rises above the step                                       LIFT
+    ADVANCE          drive, swivel held, until that wheel is over the step      ADVANCE
+    SET_DOWN         stop; swivel towards the other side: the wheel lands on
+                     the step, then the swivel lifts the front of the car until
+                     the other front wheel is ``clearance_margin`` above it     SET_DOWN
+    SECOND_ADVANCE   drive until the second front wheel is over the step        CLIMB_REST
+    SECOND_SET_DOWN  stop; swivel to 0: the second wheel lands                  CLIMB_REST
+    REAR             drive, holding the lead heading, until the rear wheels are
+                     past the edge and the car is level; the rear axle has no
+                     lift, it climbs by traction only                           CLIMB_REST
+
+Every step but APPROACH wants the *measured* swivel at an angle. Under load (a wheel lifted,
+or the front of the car lifted with one wheel on the step) the controller's PID settles short
+of its set point (measured in the sim: up to 0.3 rad with the thesis gains and an integral
+that only acts within 0.1 rad of the set point). So the planner closes an outer loop: it
+commands the wanted angle plus a bias that integrates the remaining error (``bias_gain``,
+at most ``max_bias``) once the controller's set point has caught up with the command, the
+way an operator would push the stick further.
+
+Monitors, every cycle: time allowance (TIMEOUT), nose-up pitch near the tip-over rule
+(TIP_OVER_ABORT), the swivel not closing on a wanted angle (STALL), no path length while
+driving (NO_PROGRESS), and the wheels slipping: the IMU's heading change parting from the
+odometry's by ``slip_yaw_tolerance`` (NO_PROGRESS too: the car does not go where odometry
+says; without this check a car whose front slid back off the step looked level and "past the
+edge" by odometry, a false success seen in the sim at 0.22 m). The rear axle failing to climb
+(odometry past the edge by ``rear_slip_allowance`` while the IMU still shows the car pitched)
+ends with FAILED. Any abort stops the drive and holds the swivel where it is.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+import math
+
+from swivel_car_model import kinematics
+from swivel_car_model.params import SwivelCarParams
+
+from swivel_car_planner.core.codes import ErrorCode, Phase
+from swivel_car_planner.core.config import PlannerConfig
+from swivel_car_planner.core.geometry import Pose2D, StepEdge, wrap_angle
+from swivel_car_planner.core.plan import ClimbPlan
+
+
+class Step(Enum):
+    """Internal steps of the climb: (action phase, share of the progress at its start)."""
+
+    APPROACH = (Phase.APPROACH, 0.0)
+    LIFT = (Phase.LIFT, 0.2)
+    ADVANCE = (Phase.ADVANCE, 0.3)
+    SET_DOWN = (Phase.SET_DOWN, 0.4)
+    SECOND_ADVANCE = (Phase.CLIMB_REST, 0.5)
+    SECOND_SET_DOWN = (Phase.CLIMB_REST, 0.6)
+    REAR = (Phase.CLIMB_REST, 0.65)
+    DONE = (Phase.DONE, 1.0)
+
+    @property
+    def phase(self) -> Phase:
+        return self.value[0]
+
+    @property
+    def progress_start(self) -> float:
+        return self.value[1]
+
+
+_STEPS = list(Step)
+_DRIVING = (Step.APPROACH, Step.ADVANCE, Step.SECOND_ADVANCE, Step.REAR)
+
+
+@dataclass(frozen=True)
+class Observation:
+    """What the car reports in one control cycle."""
+
+    time: float  # [s] sim time
+    x: float  # [m] odometry pose
+    y: float  # [m]
+    yaw: float  # [rad]
+    swivel: float  # [rad] measured theta2
+    swivel_rate: float  # [rad/s]
+    set_point: float  # [rad] controller's swivel set point (after its rate limiter)
+    torque: float  # [N m] controller's commanded swivel torque
+    pitch: float  # [rad] base_link pitch, REP-103: positive nose down
+    roll: float  # [rad]
+    imu_yaw: float  # [rad] heading from the IMU's orientation (any fixed offset)
+
+
+@dataclass(frozen=True)
+class Command:
+    """A swivel_car_msgs/SwivelCommand."""
+
+    angle: float  # [rad]
+    max_rate: float  # [rad/s], 0 = controller default
+    drive_speed: float  # [rad/s] at the wheels
+    hold: bool
+
+
+@dataclass(frozen=True)
+class Feedback:
+    phase: Phase
+    phase_name: str  # the phase, and within CLIMB_REST the step
+    progress: float  # [1]
+    pitch: float  # [rad]
+    roll: float  # [rad]
+    swivel_angle: float  # [rad]
+    swivel_torque: float  # [N m]
+    distance_to_edge: float  # [m] front axle contact to the edge, positive before it
+
+
+@dataclass(frozen=True)
+class Outcome:
+    success: bool
+    error_code: ErrorCode
+    message: str
+    duration: float  # [s]
+    peak_torque: float  # [N m]
+    energy: float  # [J]
+    max_pitch: float  # [rad]
+    distance_travelled: float  # [m]
+
+
+class ClimbStateMachine:
+    """Runs one planned climb. Call ``update`` every control cycle until ``outcome`` is set.
+
+    Parameters
+    ----------
+    p : SwivelCarParams
+    config : PlannerConfig
+    plan : ClimbPlan
+        From ``make_plan``.
+    step_distance, step_yaw : float
+        The request's edge, relative to the car at the first observation. # [m], [rad]
+    time_allowance : float
+        Sim time after which the climb aborts with TIMEOUT; 0 = the config's. # [s]
+    """
+
+    def __init__(self, p: SwivelCarParams, config: PlannerConfig, plan: ClimbPlan,
+                 step_distance: float, step_yaw: float, time_allowance: float = 0.0) -> None:
+        self._p = p
+        self._config = config
+        self._plan = plan
+        self._step_distance = step_distance
+        self._step_yaw = step_yaw
+        self._allowance = time_allowance if time_allowance > 0.0 else config.time_allowance
+        # Level on top: well below the pitch of the car with only its front on the step.
+        self._level = min(config.level_tolerance,
+                          0.5 * math.asin(min(1.0, plan.step_height / p.wheelbase)))
+        self._step = Step.APPROACH
+        self._edge: StepEdge | None = None
+        self._start_time = 0.0  # [s]
+        self._last: Observation | None = None
+        self._path = 0.0  # [m]
+        self._yaw_offset = 0.0  # [rad] IMU heading minus odometry heading at the start
+        self._peak_torque = 0.0  # [N m]
+        self._energy = 0.0  # [J]
+        self._max_pitch = 0.0  # [rad]
+        self._progress_ref = (0.0, 0.0)  # (time [s], path [m]) of the last progress
+        # [rad] how far the swivel is from what the step wants; None while steering
+        self._goal_error: float | None = None
+        self._stall_ref = (0.0, math.inf)  # (time [s], best error [rad]) of the last headway
+        self._at_rest_since: float | None = None
+        self._span = (0.0, 1.0)  # (start, end) of the quantity a step's progress follows
+        self._cancel_requested = False
+        self._hold_angle = 0.0  # [rad] swivel held after a failure
+        self._bias = 0.0  # [rad] outer-loop correction added to the wanted swivel angle
+        self._last_command = 0.0  # [rad] swivel angle last sent
+        self.outcome: Outcome | None = None
+        self.feedback = Feedback(Phase.PLANNING, 'PLANNING', 0.0, 0.0, 0.0, 0.0, 0.0,
+                                 step_distance)
+
+    @property
+    def phase(self) -> Phase:
+        return self._step.phase
+
+    @property
+    def step(self) -> Step:
+        return self._step
+
+    def cancel(self) -> None:
+        """End the climb at the next ``update``: stop the drive and hold the swivel."""
+        self._cancel_requested = True
+
+    def update(self, obs: Observation) -> Command:
+        """Advance the climb by one observation; returns the command to send now."""
+        if self.outcome is not None:
+            return self._final_command()
+        if self._edge is None:
+            self._start(obs)
+        self._measure(obs)
+        failure = self._monitor(obs)
+        if failure is not None:
+            return self._finish(obs, *failure)
+        command = self._advance(obs)
+        self._last = obs
+        if self.outcome is not None:
+            return self._final_command()
+        self._publish_feedback(obs)
+        return command
+
+    # --- steps ----------------------------------------------------------------------------
+
+    def _advance(self, obs: Observation) -> Command:
+        config, plan = self._config, self._plan
+        side = plan.lifted_side
+        step = self._step
+        if step == Step.APPROACH:
+            if self._lifted_wheel_distance(obs) >= -plan.lead_distance:
+                error = plan.approach_heading - self._edge.relative_heading(obs.yaw)
+                if abs(error) > config.align_tolerance:
+                    return self._finish(
+                        obs, ErrorCode.FAILED,
+                        f'reached the lift point {error:.2f} rad off the planned heading '
+                        f'(tolerance {config.align_tolerance:.2f} rad)')
+                return self._enter(Step.LIFT, obs)
+            return self._steer(obs, plan.approach_heading, config.approach_speed)
+        if step == Step.LIFT:
+            if self._settled(obs, plan.swivel_angle):
+                return self._enter(Step.ADVANCE, obs)
+            return self._hold(obs, plan.swivel_angle, 0.0)
+        if step == Step.ADVANCE:
+            if self._lifted_wheel_distance(obs) >= config.lead_margin:
+                return self._enter(Step.SET_DOWN, obs)
+            return self._hold(obs, plan.swivel_angle, config.climb_speed)
+        if step == Step.SET_DOWN:
+            # The wheel lands, then the swivel lifts the front until the second wheel is
+            # clearance_margin up: the swivel at or beyond plan.second_swivel_angle.
+            if side * obs.swivel <= side * plan.second_swivel_angle + config.swivel_tolerance:
+                return self._enter(Step.SECOND_ADVANCE, obs)
+            return self._hold(obs, plan.second_swivel_angle, 0.0)
+        if step == Step.SECOND_ADVANCE:
+            if self._second_wheel_distance(obs) >= config.lead_margin:
+                return self._enter(Step.SECOND_SET_DOWN, obs)
+            return self._hold(obs, plan.second_swivel_angle, config.climb_speed)
+        if step == Step.SECOND_SET_DOWN:
+            if self._settled(obs, 0.0):
+                return self._enter(Step.REAR, obs)
+            return self._hold(obs, 0.0, 0.0)
+        # REAR
+        rear = self._rear_wheel_distance(obs)
+        if rear >= config.rest_margin and abs(obs.pitch) <= self._level:
+            return self._finish(obs, ErrorCode.NONE,
+                                'climbed: all four wheels on top of the step')
+        if rear >= config.rest_margin + config.rear_slip_allowance:
+            return self._finish(
+                obs, ErrorCode.FAILED,
+                f'the front wheels are on top but the rear axle did not climb: odometry '
+                f'puts it {rear:.2f} m past the edge while the pitch is still {obs.pitch:.3f} '
+                f'rad (the rear wheels slip; they climb by traction only)')
+        return self._steer(obs, plan.lead_angle, config.rear_speed)
+
+    def _steer(self, obs: Observation, heading: float, drive_speed: float) -> Command:
+        """Drive at ``drive_speed`` steering towards ``heading`` (to the edge normal)."""
+        error = heading - self._edge.relative_heading(obs.yaw)
+        limit = self._config.max_steer
+        steering = min(limit, max(-limit, self._config.heading_gain * error))
+        self._bias = 0.0
+        self._goal_error = None
+        self._last_command = float(kinematics.swivel_for_steering(self._p, steering))
+        return Command(self._last_command, self._config.swivel_rate, drive_speed, True)
+
+    def _hold(self, obs: Observation, angle: float, drive_speed: float) -> Command:
+        """Bring the measured swivel to ``angle`` (outer loop, see the module docstring)
+        while driving at ``drive_speed``.
+
+        The bias integrates only once the controller's rate-limited set point has reached the
+        last command: while it still ramps, the error is the ramp's, not the load's.
+        """
+        config = self._config
+        error = angle - obs.swivel
+        dt = obs.time - self._last.time if self._last is not None else 0.0
+        if abs(obs.set_point - self._last_command) < config.swivel_tolerance:
+            self._bias = min(config.max_bias, max(
+                -config.max_bias, self._bias + config.bias_gain * error * dt))
+        self._goal_error = abs(error)
+        limit = config.max_swivel_command
+        self._last_command = min(limit, max(-limit, angle + self._bias))
+        return Command(self._last_command, config.swivel_rate, drive_speed, True)
+
+    def _settled(self, obs: Observation, target: float) -> bool:
+        """The swivel is at ``target`` and at rest for ``settle_time``."""
+        config = self._config
+        if (abs(obs.swivel - target) <= config.swivel_tolerance
+                and abs(obs.swivel_rate) <= config.settle_rate):
+            if self._at_rest_since is None:
+                self._at_rest_since = obs.time
+            return obs.time - self._at_rest_since >= config.settle_time
+        self._at_rest_since = None
+        return False
+
+    def _enter(self, step: Step, obs: Observation) -> Command:
+        """Switch to ``step`` and return its first command."""
+        self._step = step
+        self._progress_ref = (obs.time, self._path)
+        self._at_rest_since = None
+        self._stall_ref = (obs.time, math.inf)
+        plan, config = self._plan, self._config
+        spans = {
+            Step.APPROACH: (self._lifted_wheel_distance(obs), -plan.lead_distance),
+            Step.LIFT: (obs.swivel, plan.swivel_angle),
+            Step.ADVANCE: (self._lifted_wheel_distance(obs), config.lead_margin),
+            Step.SET_DOWN: (obs.swivel, plan.second_swivel_angle),
+            Step.SECOND_ADVANCE: (self._second_wheel_distance(obs), config.lead_margin),
+            Step.SECOND_SET_DOWN: (obs.swivel, 0.0),
+            Step.REAR: (self._rear_wheel_distance(obs), config.rest_margin)}
+        self._span = spans.get(step, (0.0, 1.0))
+        return self._advance(obs)
+
+    # --- geometry -------------------------------------------------------------------------
+
+    def _wheel_distance(self, obs: Observation, bx: float, by: float) -> float:
+        """Signed distance past the edge of a wheel's contact given at rest in base_link.
+
+        The rest geometry ignores how the swivel moves the front contacts (a few cm at the
+        lift angles); ``lead_margin`` and ``lift_gap`` absorb it.
+        """
+        return self._edge.signed_distance(*Pose2D(obs.x, obs.y, obs.yaw).transform(bx, by))
+
+    def _lifted_wheel_distance(self, obs: Observation) -> float:
+        return self._wheel_distance(obs, self._p.wheelbase, self._plan.lifted_side * self._p.h)
+
+    def _second_wheel_distance(self, obs: Observation) -> float:
+        return self._wheel_distance(obs, self._p.wheelbase, -self._plan.lifted_side * self._p.h)
+
+    def _rear_wheel_distance(self, obs: Observation) -> float:
+        """The rear wheel nearer the riser (the trailing one). # [m]"""
+        return min(self._wheel_distance(obs, 0.0, self._p.h),
+                   self._wheel_distance(obs, 0.0, -self._p.h))
+
+    def _progress_quantity(self, obs: Observation) -> float:
+        if self._step in (Step.APPROACH, Step.ADVANCE):
+            return self._lifted_wheel_distance(obs)
+        if self._step == Step.SECOND_ADVANCE:
+            return self._second_wheel_distance(obs)
+        if self._step == Step.REAR:
+            return self._rear_wheel_distance(obs)
+        return obs.swivel
+
+    # --- monitors and bookkeeping ---------------------------------------------------------
+
+    def _start(self, obs: Observation) -> None:
+        self._edge = StepEdge.from_request(Pose2D(obs.x, obs.y, obs.yaw), self._p.wheelbase,
+                                           self._step_distance, self._step_yaw)
+        self._start_time = obs.time
+        self._yaw_offset = obs.imu_yaw - obs.yaw
+        self._step = Step.APPROACH
+        self._progress_ref = (obs.time, 0.0)
+        self._stall_ref = (obs.time, math.inf)
+        self._span = (self._lifted_wheel_distance(obs), -self._plan.lead_distance)
+
+    def _measure(self, obs: Observation) -> None:
+        if self._last is not None:
+            dt = max(0.0, obs.time - self._last.time)
+            self._path += math.hypot(obs.x - self._last.x, obs.y - self._last.y)
+            self._energy += abs(obs.torque * obs.swivel_rate) * dt
+        self._peak_torque = max(self._peak_torque, abs(obs.torque))
+        self._max_pitch = max(self._max_pitch, abs(obs.pitch))
+
+    def _monitor(self, obs: Observation) -> tuple[ErrorCode, str] | None:
+        config = self._config
+        name = self._step.name
+        if self._cancel_requested:
+            return ErrorCode.CANCELED, 'canceled: drive stopped, swivel held'
+        if obs.time - self._start_time > self._allowance:
+            return ErrorCode.TIMEOUT, f'timed out after {self._allowance:.1f} s in {name}'
+        margin = float(kinematics.tip_over_margin(self._p, max(0.0, -obs.pitch)))
+        if margin < config.pitch_abort_margin:
+            return (ErrorCode.TIP_OVER_ABORT,
+                    f'nose-up pitch {-obs.pitch:.3f} rad is {margin:.3f} rad from tipping '
+                    f'over (abort margin {config.pitch_abort_margin:.3f} rad) in {name}')
+        # Stall: for stall_time the swivel closes less than stall_progress on the angle the
+        # step wants. Not while steering: a lagging steering angle is no hazard, and the
+        # no-progress monitor covers a car that does not move.
+        ref_time, best = self._stall_ref
+        error = self._goal_error
+        if error is None or error <= config.swivel_tolerance \
+                or error < best - config.stall_progress:
+            self._stall_ref = (obs.time, math.inf if error is None else error)
+        elif obs.time - ref_time > config.stall_time:
+            return (ErrorCode.STALL,
+                    f'the swivel made no headway for {config.stall_time:.1f} s in {name} '
+                    f'({error:.3f} rad off)')
+        slip = wrap_angle(obs.imu_yaw - obs.yaw - self._yaw_offset)
+        if abs(slip) > config.slip_yaw_tolerance:
+            return (ErrorCode.NO_PROGRESS,
+                    f'the wheels slip: the IMU heading has turned {slip:+.2f} rad away from '
+                    f'the odometry\'s in {name}')
+        if self._step in _DRIVING:
+            ref_time, ref_path = self._progress_ref
+            if self._path - ref_path >= config.min_progress:
+                self._progress_ref = (obs.time, self._path)
+            elif obs.time - ref_time > config.no_progress_time:
+                return (ErrorCode.NO_PROGRESS,
+                        f'moved less than {config.min_progress:.3f} m in '
+                        f'{config.no_progress_time:.1f} s in {name}')
+        return None
+
+    def _progress(self, obs: Observation) -> float:
+        if self._step == Step.DONE:
+            return 1.0
+        start = self._step.progress_start
+        end = _STEPS[_STEPS.index(self._step) + 1].progress_start
+        first, last = self._span
+        span = last - first
+        fraction = (self._progress_quantity(obs) - first) / span if abs(span) > 1e-9 else 1.0
+        return start + (end - start) * min(1.0, max(0.0, fraction))
+
+    def _publish_feedback(self, obs: Observation) -> None:
+        failed = self.outcome is not None and not self.outcome.success
+        phase = Phase.ABORTING if failed else self._step.phase
+        self.feedback = Feedback(
+            phase, phase.name if failed or phase != Phase.CLIMB_REST
+            else f'{phase.name}: {self._step.name}',
+            self.feedback.progress if failed else self._progress(obs),
+            obs.pitch, obs.roll, obs.swivel, obs.torque,
+            -self._wheel_distance(obs, self._p.wheelbase, 0.0))
+
+    def _finish(self, obs: Observation, code: ErrorCode, message: str) -> Command:
+        if code == ErrorCode.NONE:
+            self._step = Step.DONE
+        self.outcome = Outcome(
+            code == ErrorCode.NONE, code, message, obs.time - self._start_time,
+            self._peak_torque, self._energy, self._max_pitch, self._path)
+        self._hold_angle = obs.swivel
+        self._publish_feedback(obs)
+        return self._final_command()
+
+    def _final_command(self) -> Command:
+        """After success the swivel goes back to cmd_vel; after a failure it holds."""
+        if self.outcome.success:
+            return Command(0.0, 0.0, 0.0, False)
+        return Command(self._hold_angle, 0.0, 0.0, True)

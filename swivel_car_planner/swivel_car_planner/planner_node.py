@@ -1,0 +1,314 @@
+"""The planner node: climb_step as a service and as an action, one shared climb.
+
+A sim-time timer drives the core's ``ClimbStateMachine`` one control period at a time; the
+service and action callbacks run in a reentrant group on a multi-threaded executor and only
+wait on an event, so nothing blocks the executor.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from dataclasses import dataclass, fields
+
+from nav_msgs.msg import Odometry
+import rclpy
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.action.server import ServerGoalHandle
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+from rcl_interfaces.msg import ParameterDescriptor
+from sensor_msgs.msg import Imu, JointState
+from swivel_car_model import kinematics
+from swivel_car_model.params import SwivelCarParams
+from swivel_car_msgs.action import ClimbStep as ClimbStepAction
+from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan, SwivelCommand, SwivelControllerState
+from swivel_car_msgs.srv import ClimbStep as ClimbStepService
+
+from swivel_car_planner.conversions import (
+    outcome_to_msg, plan_to_msg, request_from, roll_pitch, yaw_of)
+from swivel_car_planner.core import (
+    ClimbRequest, ClimbStateMachine, Command, ErrorCode, Observation, PlanError,
+    PlannerConfig, make_plan, validate_request)
+
+_ROBOT_DESCRIPTIONS = {
+    'l': 'length of each T column [m]', 'h': 'half-length of each wheel shaft [m]',
+    'phi': 'angle between the T columns [rad]', 'r': 'wheel radius [m]',
+    'mass': 'total mass [kg]', 'inertia': 'inertia about the rear axle [kg m^2]',
+    'kp': 'swivel P gain [N m/rad]', 'ki': 'swivel I gain [N m/(rad s)]',
+    'kd': 'swivel D gain [N m s/rad]', 'wheel_width': 'wheel tread width [m]',
+    'wheel_mass': 'mass of each wheel [kg]', 'max_swivel_angle': 'swivel joint limit [rad]',
+}
+
+
+@dataclass
+class _ActiveClimb:
+    """The one running climb, and who waits for it."""
+
+    machine: ClimbStateMachine
+    done: threading.Event
+    goal_handle: ServerGoalHandle | None = None
+
+
+@dataclass
+class _Result:
+    """The fields shared by the service response and the action result."""
+
+    success: bool
+    error_code: int
+    message: str
+    plan: ClimbPlan
+    outcome: ClimbOutcome
+
+    def fill(self, message):
+        for name in ('success', 'error_code', 'message', 'plan', 'outcome'):
+            setattr(message, name, getattr(self, name))
+        return message
+
+
+class PlannerNode(Node):
+    """Serves ``climb_step`` (service and action); publishes ``swivel_command``."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('planner', **kwargs)
+        self.config = PlannerConfig(**{
+            item.name: float(self.declare_parameter(
+                item.name, item.default,
+                ParameterDescriptor(description=item.metadata['description'])).value)
+            for item in fields(PlannerConfig)})
+        defaults = SwivelCarParams()
+        self.robot = SwivelCarParams(**{
+            name: float(self.declare_parameter(
+                name, float(getattr(defaults, name)),
+                ParameterDescriptor(description=description)).value)
+            for name, description in _ROBOT_DESCRIPTIONS.items()})
+        self._control_period = self._positive_parameter(
+            'control_period', 0.01, 'period of the climb state machine, sim time [s]')
+        self._ready_timeout = self._positive_parameter(
+            'ready_timeout', 1.0, 'inputs older than this (sim time) mean not ready [s]')
+        self._swivel_joint = self.declare_parameter(
+            'swivel_joint', 'swivel_joint',
+            ParameterDescriptor(description='name of the swivel joint in joint_states')).value
+
+        self._lock = threading.Lock()
+        self._climb: _ActiveClimb | None = None
+        self._received: dict[str, float] = {}  # topic -> sim time of its last message [s]
+        self._odom: Odometry | None = None
+        self._swivel = (0.0, 0.0)  # (angle [rad], rate [rad/s])
+        self._imu = (0.0, 0.0, 0.0)  # (roll, pitch, yaw) [rad]
+        self._controller: SwivelControllerState | None = None
+
+        self.create_subscription(Odometry, 'odom', self._on_odom, 10)
+        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
+        self.create_subscription(Imu, 'imu', self._on_imu, 10)
+        self.create_subscription(SwivelControllerState, 'controller/controller_state',
+                                 self._on_controller_state, 10)
+        self._command_pub = self.create_publisher(SwivelCommand, 'swivel_command', 10)
+        requests = ReentrantCallbackGroup()
+        self.create_service(ClimbStepService, 'climb_step', self._on_service,
+                            callback_group=requests)
+        self._action = ActionServer(
+            self, ClimbStepAction, 'climb_step', execute_callback=self._on_execute,
+            goal_callback=self._on_goal, cancel_callback=self._on_cancel,
+            callback_group=requests)
+        self.create_timer(self._control_period, self._on_timer)
+        self.get_logger().info(
+            f'planner ready: model max scalable step {self._max_step():.3f} m, torque limit '
+            f'{self.config.torque_limit:.1f} N m')
+
+    def _positive_parameter(self, name: str, default: float, description: str) -> float:
+        value = float(self.declare_parameter(
+            name, default, ParameterDescriptor(description=description)).value)
+        if not math.isfinite(value) or value <= 0.0:
+            raise ValueError(f'parameter {name} must be finite and > 0, got {value!r}')
+        return value
+
+    def _max_step(self) -> float:
+        return kinematics.max_scalable_step(self.robot)[0]
+
+    # --- inputs ---------------------------------------------------------------------------
+
+    def _now(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _on_odom(self, msg: Odometry) -> None:
+        with self._lock:
+            self._odom = msg
+            self._received['odom'] = self._now()
+
+    def _on_joint_states(self, msg: JointState) -> None:
+        if self._swivel_joint not in msg.name:
+            return
+        index = msg.name.index(self._swivel_joint)
+        if index >= len(msg.position):
+            return
+        rate = msg.velocity[index] if index < len(msg.velocity) else 0.0
+        with self._lock:
+            self._swivel = (float(msg.position[index]), float(rate))
+            self._received['joint_states'] = self._now()
+
+    def _on_imu(self, msg: Imu) -> None:
+        q = msg.orientation
+        with self._lock:
+            self._imu = (*roll_pitch(q.x, q.y, q.z, q.w), yaw_of(q.x, q.y, q.z, q.w))
+            self._received['imu'] = self._now()
+
+    def _on_controller_state(self, msg: SwivelControllerState) -> None:
+        with self._lock:
+            self._controller = msg
+            self._received['controller/controller_state'] = self._now()
+
+    def _missing_inputs(self) -> list[str]:
+        """Inputs not heard within ``ready_timeout`` of sim time (all, before /clock)."""
+        now = self._now()
+        topics = ('joint_states', 'imu', 'odom', 'controller/controller_state')
+        with self._lock:
+            return [topic for topic in topics
+                    if now <= 0.0 or topic not in self._received
+                    or now - self._received[topic] > self._ready_timeout]
+
+    def _observation(self) -> Observation:
+        with self._lock:
+            pose = self._odom.pose.pose
+            controller = self._controller
+            return Observation(
+                time=self._now(), x=pose.position.x, y=pose.position.y,
+                yaw=yaw_of(pose.orientation.x, pose.orientation.y, pose.orientation.z,
+                           pose.orientation.w),
+                swivel=self._swivel[0], swivel_rate=self._swivel[1],
+                set_point=controller.set_point, torque=controller.torque,
+                roll=self._imu[0], pitch=self._imu[1], imu_yaw=self._imu[2])
+
+    # --- the climb ------------------------------------------------------------------------
+
+    def _run(self, request: ClimbRequest, goal_handle=None) -> _Result:
+        """Validate, plan and (unless plan_only) climb; blocks only the calling thread."""
+        code, message = validate_request(request, self.config)
+        if code != ErrorCode.NONE:
+            return self._failure(code, message)
+        missing = [] if request.plan_only else self._missing_inputs()
+        if missing:
+            return self._failure(ErrorCode.NOT_READY,
+                                 f'no recent message on {", ".join(missing)}: are the sim, '
+                                 f'controller and odometry running?')
+        try:
+            plan = make_plan(self.robot, self.config, request)
+        except PlanError as error:
+            return self._failure(error.code, error.message)
+        if request.plan_only:
+            return _Result(True, int(ErrorCode.NONE), 'plan only: the robot did not move',
+                           plan_to_msg(plan), ClimbOutcome())
+        climb = _ActiveClimb(
+            ClimbStateMachine(self.robot, self.config, plan, request.step_distance,
+                              request.step_yaw, request.time_allowance),
+            threading.Event(), goal_handle)
+        with self._lock:
+            if self._climb is not None:
+                return self._failure(ErrorCode.BUSY, 'a climb is already running')
+            self._climb = climb
+        self.get_logger().info(
+            f'climbing a {request.step_height:.3f} m step {request.step_distance:.2f} m ahead: '
+            f'swivel {plan.swivel_angle:.3f} rad, approach heading '
+            f'{plan.approach_heading:.3f} rad')
+        while not climb.done.wait(0.1):
+            if not self.context.ok():
+                return self._failure(ErrorCode.CANCELED, 'the planner is shutting down')
+        outcome = climb.machine.outcome
+        if outcome.success:
+            self.get_logger().info(f'climb ended: {outcome.message}')
+        else:
+            self.get_logger().warning(f'climb ended ({outcome.error_code.name}): '
+                                      f'{outcome.message}')
+        return _Result(outcome.success, int(outcome.error_code), outcome.message,
+                       plan_to_msg(plan), outcome_to_msg(outcome))
+
+    def _failure(self, code: ErrorCode, message: str) -> _Result:
+        self.get_logger().warning(f'climb_step refused ({code.name}): {message}')
+        return _Result(False, int(code), message, ClimbPlan(), ClimbOutcome())
+
+    def _on_timer(self) -> None:
+        with self._lock:
+            climb = self._climb
+        if climb is None:
+            return
+        if climb.goal_handle is not None and climb.goal_handle.is_cancel_requested:
+            climb.machine.cancel()
+        command = climb.machine.update(self._observation())
+        self._publish_command(command)
+        if climb.goal_handle is not None:
+            climb.goal_handle.publish_feedback(self._feedback_msg(climb.machine.feedback))
+        if climb.machine.outcome is not None:
+            with self._lock:
+                self._climb = None
+            climb.done.set()
+
+    def _publish_command(self, command: Command) -> None:
+        msg = SwivelCommand()
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.angle = float(command.angle)
+        msg.max_rate = float(command.max_rate)
+        msg.drive_speed = float(command.drive_speed)
+        msg.hold = bool(command.hold)
+        self._command_pub.publish(msg)
+
+    @staticmethod
+    def _feedback_msg(feedback) -> ClimbStepAction.Feedback:
+        msg = ClimbStepAction.Feedback()
+        msg.phase = int(feedback.phase)
+        msg.phase_name = feedback.phase_name
+        for name in ('progress', 'pitch', 'roll', 'swivel_angle', 'swivel_torque',
+                     'distance_to_edge'):
+            setattr(msg, name, float(getattr(feedback, name)))
+        return msg
+
+    # --- service and action ---------------------------------------------------------------
+
+    def _on_service(self, request, response):
+        return self._run(request_from(request, with_time_allowance=False)).fill(response)
+
+    def _on_goal(self, goal) -> GoalResponse:
+        with self._lock:
+            busy = self._climb is not None
+        if busy and not goal.plan_only:
+            self.get_logger().warning('climb_step goal rejected: a climb is already running')
+            return GoalResponse.REJECT
+        return GoalResponse.ACCEPT
+
+    def _on_cancel(self, goal_handle) -> CancelResponse:
+        return CancelResponse.ACCEPT
+
+    def _on_execute(self, goal_handle):
+        result = self._run(request_from(goal_handle.request, with_time_allowance=True),
+                           goal_handle)
+        if result.success:
+            goal_handle.succeed()
+        elif result.error_code == ErrorCode.CANCELED and goal_handle.is_cancel_requested:
+            goal_handle.canceled()
+        else:
+            goal_handle.abort()
+        return result.fill(ClimbStepAction.Result())
+
+    def destroy_node(self) -> None:
+        self._action.destroy()
+        super().destroy_node()
+
+
+def main(args=None) -> None:
+    rclpy.init(args=args)
+    executor = MultiThreadedExecutor(num_threads=6)
+    node = None
+    try:
+        node = PlannerNode()
+        executor.add_node(node)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,223 @@
+"""The whole stack in the real pybullet sim, for system tests and the benchmark.
+
+``SimSession`` starts sim_node (lockstep), controller_node, odometry_node and planner_node as
+processes on a fresh ROS domain, each with its package's installed config, and gives an
+in-process client: spawn a step, reset the sim, call climb_step (service or action), read the
+ground truth. Processes come from the repository's scripts/swivel_car_stack.py.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+import os
+from pathlib import Path
+import sys
+import time
+from typing import Any, Callable
+
+from nav_msgs.msg import Odometry
+import rclpy
+from rclpy.action import ActionClient
+from rclpy.executors import SingleThreadedExecutor
+from std_srvs.srv import Empty
+from swivel_car_model.params import SwivelCarParams
+from swivel_car_msgs.action import ClimbStep as ClimbStepAction
+from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
+from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
+
+try:
+    from swivel_car_testing import next_domain_id, spin_until
+except ImportError:  # outside pytest: the repository's helpers (pytest.ini puts them on the path)
+    _REPO = Path(__file__).resolve().parents[2]
+    sys.path += [str(_REPO / 'scripts'), str(_REPO / 'tests' / 'support')]
+    from swivel_car_testing import next_domain_id, spin_until
+from swivel_car_stack import config_path, NodeProcess
+
+CLIMB_WALL_LIMIT = 600.0  # [s] guard against a hung stack, not a measurement
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """The sim's ground_truth/odom, base_link in the world frame."""
+
+    x: float  # [m]
+    y: float  # [m]
+    z: float  # [m]
+    roll: float  # [rad]
+    pitch: float  # [rad]
+    yaw: float  # [rad]
+    speed: float  # [m/s] |linear velocity|
+
+
+def _ground_truth(msg: Odometry) -> GroundTruth:
+    q = msg.pose.pose.orientation
+    roll = math.atan2(2.0 * (q.w * q.x + q.y * q.z), 1.0 - 2.0 * (q.x * q.x + q.y * q.y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (q.w * q.y - q.z * q.x))))
+    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    v = msg.twist.twist.linear
+    p = msg.pose.pose.position
+    return GroundTruth(p.x, p.y, p.z, roll, pitch, yaw, math.sqrt(v.x ** 2 + v.y ** 2 + v.z ** 2))
+
+
+class SimSession:
+    """The stack on its own ROS domain, and a client node to drive it.
+
+    Parameters
+    ----------
+    robot_variant : str
+        The sim's robot: 'swivel' or 'car_like'.
+    planner_parameters : mapping
+        ``-p`` overrides for planner_node.
+    planner : bool
+        Start planner_node (the car-like baseline is driven with cmd_vel only).
+    """
+
+    def __init__(self, robot_variant: str = 'swivel',
+                 planner_parameters: dict[str, Any] | None = None,
+                 planner: bool = True) -> None:
+        self.domain_id = next_domain_id()
+        # The car-like baseline steers a turntable joint; the controller drives it the same way.
+        joint = {'swivel_joint': 'steering_joint' if robot_variant == 'car_like'
+                 else 'swivel_joint'}
+        sim_time = {'use_sim_time': True, **joint}
+        specs = [('swivel_car_sim', 'sim_node',
+                  {'lockstep': True, 'lockstep_timeout': 2.0, 'robot_variant': robot_variant}),
+                 ('swivel_car_control', 'controller_node', sim_time),
+                 ('swivel_car_control', 'odometry_node', sim_time)]
+        if planner:
+            specs.append(('swivel_car_planner', 'planner_node',
+                          {**sim_time, **(planner_parameters or {})}))
+        self.processes: list[NodeProcess] = []
+        try:
+            for package, executable, parameters in specs:
+                self.processes.append(NodeProcess(
+                    package, executable, self.domain_id, parameters,
+                    params_file=config_path(package, f'{executable}.yaml')))
+            os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+            self.context = rclpy.Context()
+            rclpy.init(context=self.context, domain_id=self.domain_id)
+            self.node = rclpy.create_node('climb_client', context=self.context)
+            self.executor = SingleThreadedExecutor(context=self.context)
+            self.executor.add_node(self.node)
+        except BaseException:
+            self._stop_processes()
+            raise
+        self.truth: GroundTruth | None = None
+        self.controller_state: SwivelControllerState | None = None
+        self.odom_count = 0
+        self.node.create_subscription(Odometry, 'ground_truth/odom', self._on_truth, 10)
+        self.node.create_subscription(Odometry, 'odom', self._on_odom, 10)
+        self.node.create_subscription(SwivelControllerState, 'controller/controller_state',
+                                      self._on_controller_state, 10)
+        self.spawn_client = self.node.create_client(SpawnObstacle, 'sim/spawn_obstacle')
+        self.reset_client = self.node.create_client(ResetSimulation, 'sim/reset')
+        self.odometry_reset = self.node.create_client(Empty, 'odometry/reset')
+        self.climb_client = self.node.create_client(ClimbStep, 'climb_step')
+        self.climb_action = ActionClient(self.node, ClimbStepAction, 'climb_step')
+        self.swivel_command = self.node.create_publisher(SwivelCommand, 'swivel_command', 10)
+        self._planner = planner
+
+    def _on_truth(self, msg: Odometry) -> None:
+        self.truth = _ground_truth(msg)
+
+    def _on_odom(self, msg: Odometry) -> None:
+        self.odom_count += 1
+
+    def _on_controller_state(self, msg: SwivelControllerState) -> None:
+        self.controller_state = msg
+
+    def spin_until(self, condition: Callable[[], bool], timeout: float, what: str) -> None:
+        spin_until(self.executor, condition, timeout, what)
+
+    def wait_ready(self, timeout: float = 60.0) -> None:
+        """Until the sim, the controller and the odometry publish and the services are up."""
+        clients = [self.spawn_client, self.reset_client, self.odometry_reset]
+        if self._planner:
+            clients.append(self.climb_client)
+        self.spin_until(lambda: (self.truth is not None and self.odom_count > 0
+                                 and self.controller_state is not None
+                                 and all(c.service_is_ready() for c in clients)),
+                        timeout, 'the stack (sim, controller, odometry, planner)')
+        if self._planner:
+            self.spin_until(self.climb_action.server_is_ready, timeout, 'the climb action')
+            # The planner hears the stack too: a step out of reach is refused as unreachable,
+            # without motion, once it is ready.
+            deadline = time.monotonic() + timeout
+            while self.climb(10.0, 1.0).error_code == ClimbStep.Response.ERROR_NOT_READY:
+                if time.monotonic() > deadline:
+                    raise AssertionError('the planner never got ready')
+                self.settle(0.2)
+
+    def call(self, client, request, timeout: float = 30.0):
+        future = client.call_async(request)
+        self.spin_until(future.done, timeout, f'{client.srv_name}')
+        return future.result()
+
+    def reset(self, x: float = 0.0, y: float = 0.0, yaw: float = 0.0) -> None:
+        """Robot back at rest at the pose, obstacles removed, odometry zeroed."""
+        response = self.call(self.reset_client, ResetSimulation.Request(
+            x=x, y=y, yaw=yaw, remove_obstacles=True))
+        if not response.success:
+            raise RuntimeError(f'sim reset failed: {response.message}')
+        self.call(self.odometry_reset, Empty.Request())
+        self.settle(0.5)
+
+    def settle(self, seconds: float) -> None:
+        """Let ``seconds`` of wall time pass while spinning (the sim keeps stepping)."""
+        end = time.monotonic() + seconds
+        self.spin_until(lambda: time.monotonic() > end, seconds + 5.0, 'time to pass')
+
+    def spawn_step(self, height: float, distance: float, yaw: float = 0.0,
+                   depth: float = 2.0, width: float = 3.0, friction: float = 1.0) -> str:
+        response = self.call(self.spawn_client, SpawnObstacle.Request(obstacle=StepObstacle(
+            name='', height=height, depth=depth, width=width, distance=distance, yaw=yaw,
+            friction=friction)))
+        if not response.success:
+            raise RuntimeError(f'spawn failed: {response.message}')
+        return response.name
+
+    def climb(self, height: float, distance: float, yaw: float = 0.0,
+              plan_only: bool = False) -> ClimbStep.Response:
+        """The climb_step service call users make; returns when the climb ends."""
+        return self.call(self.climb_client, ClimbStep.Request(
+            step_height=height, step_distance=distance, step_yaw=yaw, plan_only=plan_only),
+            timeout=CLIMB_WALL_LIMIT)
+
+    def drive_straight(self, drive_speed: float, seconds: float) -> None:
+        """Hold the steering at 0 and drive for ``seconds`` of wall time, then stop."""
+        for speed, duration in ((drive_speed, seconds), (0.0, 0.5)):
+            self.swivel_command.publish(SwivelCommand(angle=0.0, drive_speed=speed, hold=True))
+            self.settle(duration)
+        self.swivel_command.publish(SwivelCommand(hold=False))
+
+    def front_on_top(self, height: float, tolerance: float = 0.015) -> bool:
+        """Ground truth: the front axle (wheelbase ahead of base_link) at step height."""
+        truth = self.truth
+        front = truth.z - self.wheelbase * math.sin(truth.pitch)
+        return front > height + self.wheel_radius - tolerance
+
+    def four_wheels_on_top(self, height: float, tolerance: float = 0.01) -> bool:
+        """Ground truth: the rear axle (base_link) at step height and the car level."""
+        truth = self.truth
+        return (truth is not None and abs(truth.z - (height + self.wheel_radius)) < tolerance
+                and abs(truth.pitch) < 0.05 and abs(truth.roll) < 0.05)
+
+    # The installed configs' geometry is thesis Table 2, SwivelCarParams' defaults.
+    wheel_radius = SwivelCarParams().r  # [m]
+    wheelbase = SwivelCarParams().wheelbase  # [m]
+
+    def close(self) -> list[str]:
+        """Stop everything; returns the logs of processes that died on their own."""
+        crashed = [f'{p.name}:\n{p.output()}' for p in self.processes if not p.running()]
+        try:
+            self.climb_action.destroy()
+            self.node.destroy_node()
+            rclpy.try_shutdown(context=self.context)
+        finally:
+            self._stop_processes()
+        return crashed
+
+    def _stop_processes(self) -> None:
+        for process in reversed(self.processes):
+            process.stop()

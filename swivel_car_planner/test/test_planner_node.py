@@ -1,0 +1,295 @@
+"""Node tests: the real PlannerNode in-process with real rclpy, fed by a kinematic car.
+
+The test plays the robot: it publishes /clock, joint_states, imu, odom and the controller
+state of ``KinematicCar`` (the model's planar kinematics) and applies the planner's
+swivel_command to it, so the service and action run whole climbs without the sim.
+"""
+
+from dataclasses import fields
+import math
+import os
+from pathlib import Path
+import threading
+import time
+
+from action_msgs.msg import GoalStatus
+from nav_msgs.msg import Odometry
+import pytest
+import rclpy
+import yaml
+from rclpy.action import ActionClient
+from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
+from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Imu, JointState
+from swivel_car_msgs.action import ClimbStep as ClimbStepAction
+from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
+from swivel_car_msgs.srv import ClimbStep as ClimbStepService
+from swivel_car_testing import next_domain_id, spin_until
+from swivel_car_model.params import SwivelCarParams
+
+from swivel_car_planner.core import Command, ErrorCode, Phase, PlannerConfig
+from swivel_car_planner.kinematic_car import KinematicCar
+from swivel_car_planner.planner_node import PlannerNode
+
+SUCCESSFUL_CLIMB = dict(step_height=0.05, step_distance=1.2, step_yaw=0.0)
+
+
+def test_error_codes_and_phases_match_the_interfaces():
+    response = ClimbStepService.Response
+    for code in ErrorCode:
+        assert getattr(response, f'ERROR_{code.name}') == code.value
+    for phase in Phase:
+        assert getattr(ClimbStepAction.Feedback, f'PHASE_{phase.name}') == phase.value
+
+
+class Rig:
+    """Planner on a multi-threaded executor in a thread; the test's robot and clients."""
+
+    def __init__(self):
+        os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context, domain_id=next_domain_id())
+        self.planner = PlannerNode_with_sim_time(self.context)
+        self.planner_executor = MultiThreadedExecutor(num_threads=6, context=self.context)
+        self.planner_executor.add_node(self.planner)
+        self.thread = threading.Thread(target=self.planner_executor.spin, daemon=True)
+        self.thread.start()
+        self.node = rclpy.create_node('robot', context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.car = KinematicCar()
+        self.command = None
+        self.node.create_subscription(SwivelCommand, 'swivel_command', self._on_command, 10)
+        self.clock = self.node.create_publisher(Clock, '/clock', 10)
+        self.joints = self.node.create_publisher(JointState, 'joint_states', 10)
+        self.imu = self.node.create_publisher(Imu, 'imu', 10)
+        self.odom = self.node.create_publisher(Odometry, 'odom', 10)
+        self.state = self.node.create_publisher(
+            SwivelControllerState, 'controller/controller_state', 10)
+        self.service = self.node.create_client(ClimbStepService, 'climb_step')
+        self.action = ActionClient(self.node, ClimbStepAction, 'climb_step')
+        spin_until(self.executor, self.service.service_is_ready, 10.0, 'the service')
+        spin_until(self.executor, self.action.server_is_ready, 10.0, 'the action server')
+
+    def _on_command(self, msg):
+        self.command = Command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold)
+
+    def publish_state(self, inputs=('joint_states', 'imu', 'odom', 'controller')):
+        """One control cycle of the robot: clock, then the requested inputs."""
+        car = self.car
+        stamp = rclpy.time.Time(nanoseconds=car.cycles * 10_000_000).to_msg()
+        self.clock.publish(Clock(clock=stamp))
+        obs = car.observe()
+        if 'joint_states' in inputs:
+            msg = JointState(name=['swivel_joint'], position=[car.swivel],
+                             velocity=[car.rate], effort=[0.0])
+            msg.header.stamp = stamp
+            self.joints.publish(msg)
+        if 'imu' in inputs:
+            msg = Imu()
+            msg.header.stamp = stamp
+            # Yaw then pitch: q = q_z(yaw) * q_y(pitch).
+            cy, sy = math.cos(obs.imu_yaw / 2.0), math.sin(obs.imu_yaw / 2.0)
+            cp, sp = math.cos(obs.pitch / 2.0), math.sin(obs.pitch / 2.0)
+            msg.orientation.x, msg.orientation.y = -sy * sp, cy * sp
+            msg.orientation.z, msg.orientation.w = sy * cp, cy * cp
+            self.imu.publish(msg)
+        if 'odom' in inputs:
+            msg = Odometry()
+            msg.header.stamp = stamp
+            msg.pose.pose.position.x = obs.x
+            msg.pose.pose.position.y = obs.y
+            msg.pose.pose.orientation.z = math.sin(obs.yaw / 2.0)
+            msg.pose.pose.orientation.w = math.cos(obs.yaw / 2.0)
+            self.odom.publish(msg)
+        if 'controller' in inputs:
+            msg = SwivelControllerState(set_point=car.set_point, measured=car.swivel,
+                                        torque=obs.torque, source='hold')
+            msg.header.stamp = stamp
+            self.state.publish(msg)
+
+    def drive(self, future, seconds=120.0):
+        """Close the loop until ``future`` is done: the car follows the planner's commands.
+
+        Lockstep by hand: each cycle waits (briefly) for the planner's command of that cycle;
+        until a climb is registered there is none, and the car keeps the last one.
+        """
+        last = Command(0.0, 0.0, 0.0, False)
+        while not future.done() and self.car.time < seconds:
+            self.publish_state()
+            deadline = time.monotonic() + 0.5
+            while self.command is None and not future.done() and time.monotonic() < deadline:
+                self.executor.spin_once(timeout_sec=0.005)
+            if self.command is not None:
+                last, self.command = self.command, None
+            self.car.apply(last)
+        spin_until(self.executor, future.done, 10.0, 'the result')
+        return future.result()
+
+    def warm_up(self, cycles=30, inputs=('joint_states', 'imu', 'odom', 'controller')):
+        for _ in range(cycles):
+            self.publish_state(inputs)
+            self.car.cycles += 1
+            self.executor.spin_once(timeout_sec=0.005)
+
+    def call(self, **fields):
+        return self.service.call_async(ClimbStepService.Request(**fields))
+
+    def close(self):
+        self.action.destroy()
+        self.planner_executor.shutdown()
+        self.planner.destroy_node()
+        self.node.destroy_node()
+        rclpy.shutdown(context=self.context)
+        self.thread.join(5.0)
+
+
+def PlannerNode_with_sim_time(context):  # noqa: N802
+    return PlannerNode(context=context,
+                       parameter_overrides=[Parameter('use_sim_time', value=True)])
+
+
+@pytest.fixture
+def rig():
+    rig = Rig()
+    yield rig
+    rig.close()
+
+
+def result_of(rig, future):
+    spin_until(rig.executor, future.done, 10.0, 'the response')
+    return future.result()
+
+
+def test_malformed_request_is_invalid_and_nothing_moves(rig):
+    rig.warm_up()
+    response = result_of(rig, rig.call(step_height=math.nan, step_distance=1.0))
+    assert not response.success
+    assert response.error_code == ClimbStepService.Response.ERROR_INVALID_REQUEST
+    assert 'step_height' in response.message
+    assert rig.command is None
+
+
+def test_request_before_the_robot_is_up_is_not_ready(rig):
+    response = result_of(rig, rig.call(**SUCCESSFUL_CLIMB))
+    assert response.error_code == ClimbStepService.Response.ERROR_NOT_READY
+    rig.warm_up(inputs=('joint_states', 'imu', 'controller'))  # no odometry
+    response = result_of(rig, rig.call(**SUCCESSFUL_CLIMB))
+    assert response.error_code == ClimbStepService.Response.ERROR_NOT_READY
+    assert 'odom' in response.message
+    assert rig.command is None
+
+
+def test_plan_only_returns_the_plan_without_moving(rig):
+    response = result_of(rig, rig.call(**SUCCESSFUL_CLIMB, plan_only=True))
+    assert response.success, response.message
+    assert response.plan.swivel_angle > 0.0
+    assert response.plan.tip_over_margin > 0.0
+    assert response.plan.duration > 0.0
+    assert rig.command is None
+
+
+def test_unreachable_step_is_refused_without_motion(rig):
+    rig.warm_up()
+    response = result_of(rig, rig.call(step_height=0.5, step_distance=1.0))
+    assert response.error_code == ClimbStepService.Response.ERROR_UNREACHABLE_HEIGHT
+    assert rig.command is None
+
+
+def test_service_climbs_and_a_second_request_meanwhile_is_busy(rig):
+    rig.warm_up()
+    climb = rig.call(**SUCCESSFUL_CLIMB)
+    second = []
+
+    def call_again_once_moving():
+        if not second and rig.car.time > 1.0:
+            second.append(rig.call(**SUCCESSFUL_CLIMB))
+
+    original_apply = rig.car.apply
+
+    def apply(command):
+        call_again_once_moving()
+        original_apply(command)
+
+    rig.car.apply = apply
+    response = rig.drive(climb)
+    assert response.success, response.message
+    assert response.outcome.distance_travelled > 1.0
+    busy = result_of(rig, second[0])
+    assert busy.error_code == ClimbStepService.Response.ERROR_BUSY
+
+
+def send_goal(rig, feedback, **fields):
+    goal = ClimbStepAction.Goal(**fields)
+    future = rig.action.send_goal_async(goal, feedback_callback=lambda m: feedback.append(
+        m.feedback))
+    spin_until(rig.executor, future.done, 10.0, 'the goal response')
+    return future.result()
+
+
+def test_action_reports_feedback_and_rejects_a_second_goal(rig):
+    rig.warm_up()
+    feedback = []
+    handle = send_goal(rig, feedback, **SUCCESSFUL_CLIMB)
+    assert handle.accepted
+    result_future = handle.get_result_async()
+    # Drive a second into the climb, then try a second goal: rejected.
+    rig.drive(_Deadline(rig, 1.0))
+    other = send_goal(rig, [], **SUCCESSFUL_CLIMB)
+    assert not other.accepted
+    wrapped = rig.drive(result_future)
+    assert wrapped.result.success, wrapped.result.message
+    phases = [f.phase for f in feedback]
+    assert phases[0] == Phase.APPROACH and Phase.CLIMB_REST in phases
+    assert phases == sorted(phases)
+    assert feedback[-1].progress == pytest.approx(1.0)
+
+
+def test_action_cancel_stops_the_drive_and_holds_the_swivel(rig):
+    rig.warm_up()
+    handle = send_goal(rig, [], **SUCCESSFUL_CLIMB)
+    result_future = handle.get_result_async()
+    rig.drive(_Deadline(rig, 2.0))
+    cancel = handle.cancel_goal_async()
+    wrapped = rig.drive(result_future)
+    assert cancel.done()
+    assert wrapped.status == GoalStatus.STATUS_CANCELED
+    assert wrapped.result.error_code == ErrorCode.CANCELED
+    last = rig.car.commands[-1]
+    assert last.drive_speed == 0.0 and last.hold
+    assert last.angle == pytest.approx(rig.car.swivel, abs=1e-6)
+
+
+class _Deadline:
+    """A future-like that is done once the rig's car reaches ``seconds`` of sim time."""
+
+    def __init__(self, rig, seconds):
+        self._rig, self._end = rig, rig.car.time + seconds
+
+    def done(self):
+        return self._rig.car.time >= self._end
+
+    def result(self):
+        return None
+
+
+def test_config_file_matches_the_declared_defaults():
+    path = Path(__file__).resolve().parents[1] / 'config' / 'planner_node.yaml'
+    values = yaml.safe_load(path.read_text())['/**']['planner']['ros__parameters']
+    config, robot = PlannerConfig(), SwivelCarParams()
+    for item in fields(PlannerConfig):
+        assert values[item.name] == pytest.approx(getattr(config, item.name)), item.name
+    for item in fields(SwivelCarParams):
+        assert values[item.name] == pytest.approx(getattr(robot, item.name)), item.name
+
+
+def test_bad_parameter_is_a_clear_error_at_start():
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=next_domain_id())
+    try:
+        with pytest.raises(ValueError, match='torque_limit'):
+            PlannerNode(context=context,
+                        parameter_overrides=[Parameter('torque_limit', value=-1.0)])
+    finally:
+        rclpy.shutdown(context=context)

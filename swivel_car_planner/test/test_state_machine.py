@@ -1,0 +1,199 @@
+"""Unit tests of the climb state machine against a kinematic car on flat ground.
+
+``KinematicCar`` (no step, no physics) checks the sequencing, the geometry of the phase
+changes and every monitor; the real physics is in the system tests.
+"""
+
+import dataclasses
+import math
+
+import pytest
+from swivel_car_model.params import SwivelCarParams
+
+from swivel_car_planner.core import (
+    ClimbRequest, ClimbStateMachine, Command, ErrorCode, Phase, PlannerConfig, make_plan)
+from swivel_car_planner.core.geometry import Pose2D, StepEdge
+from swivel_car_planner.core.state_machine import Step
+from swivel_car_planner.kinematic_car import KinematicCar
+
+P = SwivelCarParams()
+CONFIG = PlannerConfig()
+
+
+def start(height=0.05, distance=1.2, yaw=0.0, config=CONFIG, allowance=0.0):
+    request = ClimbRequest(height, distance, yaw, time_allowance=allowance)
+    plan = make_plan(P, config, request)
+    return ClimbStateMachine(P, config, plan, distance, yaw, allowance), plan
+
+
+def run(machine, car, seconds=120.0, until=None):
+    """Run until the outcome (or ``until(machine, car)``); returns the phases seen."""
+    phases = []
+    while machine.outcome is None and car.time < seconds:
+        if until is not None and until(machine, car):
+            break
+        car.apply(machine.update(car.observe()))
+        if not phases or phases[-1] != machine.feedback.phase:
+            phases.append(machine.feedback.phase)
+    return phases
+
+
+@pytest.mark.parametrize('yaw', [0.0, 0.3, -0.4])
+def test_climb_goes_through_every_phase_and_ends_with_all_wheels_past_the_edge(yaw):
+    machine, plan = start(yaw=yaw)
+    car = KinematicCar()
+    phases = run(machine, car)
+    assert machine.outcome.success, machine.outcome.message
+    assert phases == [Phase.APPROACH, Phase.LIFT, Phase.ADVANCE, Phase.SET_DOWN,
+                      Phase.CLIMB_REST, Phase.DONE]
+    edge = StepEdge.from_request(Pose2D(0.0, 0.0, 0.0), P.wheelbase, 1.2, yaw)
+    pose = Pose2D(car.odometry.x, car.odometry.y, car.odometry.yaw)
+    for side in (1.0, -1.0):
+        assert edge.signed_distance(*pose.transform(0.0, side * P.h)) >= CONFIG.rest_margin
+    assert car.commands[-1] == Command(0.0, 0.0, 0.0, False)  # swivel back to cmd_vel
+    assert machine.feedback.progress == 1.0
+    assert machine.outcome.distance_travelled > 1.2
+    assert machine.outcome.peak_torque >= 10.0 * abs(plan.swivel_angle) - 0.1
+    assert machine.outcome.energy > 0.0
+
+
+def test_lift_starts_at_the_planned_distance_and_heading():
+    machine, plan = start(yaw=0.2)
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.phase == Phase.LIFT)
+    edge = StepEdge.from_request(Pose2D(0.0, 0.0, 0.0), P.wheelbase, 1.2, 0.2)
+    pose = Pose2D(car.odometry.x, car.odometry.y, car.odometry.yaw)
+    lifted = edge.signed_distance(*pose.transform(P.wheelbase, plan.lifted_side * P.h))
+    assert lifted == pytest.approx(-plan.lead_distance, abs=0.01)
+    assert edge.relative_heading(car.odometry.yaw) == pytest.approx(
+        plan.approach_heading, abs=CONFIG.align_tolerance)
+
+
+def test_lifted_wheel_is_over_the_edge_when_it_is_set_down():
+    machine, plan = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.phase == Phase.SET_DOWN)
+    edge = StepEdge.from_request(Pose2D(0.0, 0.0, 0.0), P.wheelbase, 1.2, 0.0)
+    pose = Pose2D(car.odometry.x, car.odometry.y, car.odometry.yaw)
+    assert edge.signed_distance(
+        *pose.transform(P.wheelbase, plan.lifted_side * P.h)) >= CONFIG.lead_margin
+    assert edge.signed_distance(
+        *pose.transform(P.wheelbase, -plan.lifted_side * P.h)) < 0.0
+    assert car.swivel == pytest.approx(plan.swivel_angle, abs=CONFIG.swivel_tolerance)
+
+
+def test_outer_loop_reaches_the_wanted_angles_when_the_swivel_sags_under_load():
+    machine, plan = start()
+    car = KinematicCar()
+    car.sag = 0.15
+    run(machine, car, until=lambda m, c: m.phase == Phase.ADVANCE)
+    assert car.swivel == pytest.approx(plan.swivel_angle, abs=CONFIG.swivel_tolerance)
+    assert car.commands[-1].angle > plan.swivel_angle + 0.1
+    run(machine, car)
+    assert machine.outcome.success, machine.outcome.message
+
+
+def test_rear_axle_that_does_not_climb_ends_failed_and_stopped():
+    machine, _ = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.step == Step.REAR)
+    car.extra_pitch = -0.1  # front on the step, rear still below: nose up
+    run(machine, car)
+    assert_safe_abort(machine, car, ErrorCode.FAILED)
+    assert 'rear axle' in machine.outcome.message
+
+
+def test_progress_never_goes_back():
+    machine, _ = start()
+    car = KinematicCar()
+    progress = []
+    while machine.outcome is None:
+        car.apply(machine.update(car.observe()))
+        progress.append(machine.feedback.progress)
+    assert all(b >= a - 0.02 for a, b in zip(progress, progress[1:]))
+
+
+def assert_safe_abort(machine, car, code):
+    assert machine.outcome is not None and not machine.outcome.success
+    assert machine.outcome.error_code == code, machine.outcome.message
+    assert machine.feedback.phase == Phase.ABORTING
+    final = car.commands[-1]
+    assert final.drive_speed == 0.0 and final.hold
+    assert final.angle == pytest.approx(car.swivel)
+    # Further updates keep the car stopped and the swivel held.
+    assert machine.update(car.observe()) == final
+
+
+def test_cancel_stops_the_drive_and_holds_the_swivel():
+    machine, _ = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.phase == Phase.LIFT and abs(c.swivel) > 0.1)
+    machine.cancel()
+    car.apply(machine.update(car.observe()))
+    assert_safe_abort(machine, car, ErrorCode.CANCELED)
+
+
+def test_stuck_swivel_is_a_stall():
+    machine, _ = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.phase == Phase.LIFT)
+    car.stuck = True
+    run(machine, car)
+    assert_safe_abort(machine, car, ErrorCode.STALL)
+
+
+def test_blocked_drive_is_no_progress():
+    machine, _ = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.phase == Phase.ADVANCE)
+    car.blocked = True
+    started = car.time
+    run(machine, car)
+    assert_safe_abort(machine, car, ErrorCode.NO_PROGRESS)
+    assert car.time - started == pytest.approx(CONFIG.no_progress_time, abs=0.05)
+
+
+def test_nose_up_pitch_near_tip_over_aborts():
+    machine, _ = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.phase == Phase.ADVANCE)
+    limit = math.pi / 2 - P.phi / 2
+    car.extra_pitch = -(limit - CONFIG.pitch_abort_margin + 0.01)
+    car.apply(machine.update(car.observe()))
+    assert_safe_abort(machine, car, ErrorCode.TIP_OVER_ABORT)
+
+
+def test_nose_down_pitch_is_no_tip_over():
+    machine, _ = start()
+    car = KinematicCar()
+    car.extra_pitch = 0.3
+    car.apply(machine.update(car.observe()))
+    assert machine.outcome is None
+
+
+def test_heading_slip_between_imu_and_odometry_is_no_progress():
+    machine, _ = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.phase == Phase.CLIMB_REST)
+    car.extra_yaw = CONFIG.slip_yaw_tolerance + 0.01
+    car.apply(machine.update(car.observe()))
+    assert_safe_abort(machine, car, ErrorCode.NO_PROGRESS)
+    assert 'slip' in machine.outcome.message
+
+
+def test_time_allowance_aborts_with_timeout():
+    machine, _ = start(allowance=2.0)
+    car = KinematicCar()
+    run(machine, car)
+    assert_safe_abort(machine, car, ErrorCode.TIMEOUT)
+    assert car.time == pytest.approx(2.0, abs=0.05)
+
+
+def test_reaching_the_lift_point_misaligned_fails_safely():
+    # A steering gain of zero never aligns.
+    config = dataclasses.replace(CONFIG, heading_gain=0.0)
+    machine, _ = start(config=config)
+    car = KinematicCar()
+    run(machine, car)
+    assert_safe_abort(machine, car, ErrorCode.FAILED)
+    assert 'heading' in machine.outcome.message

@@ -1,0 +1,98 @@
+"""System tests: sim_node (lockstep), controller_node, odometry_node and planner_node as real
+processes; the climb is judged by the sim's ground truth."""
+
+import math
+
+from action_msgs.msg import GoalStatus
+import pytest
+from swivel_car_msgs.action import ClimbStep as ClimbStepAction
+from swivel_car_msgs.srv import ClimbStep
+
+from swivel_car_planner.core import ErrorCode, Phase
+from swivel_car_planner.sim_session import SimSession
+
+HEIGHT = 0.04  # [m] within the rear axle's traction limit (README: measured limits)
+DISTANCE = 1.2  # [m]
+
+
+@pytest.fixture(scope='module')
+def session():
+    session = SimSession()
+    try:
+        session.wait_ready()
+        yield session
+    finally:
+        crashed = session.close()
+    assert not crashed, crashed
+
+
+@pytest.fixture
+def stack(session):
+    session.reset()
+    return session
+
+
+def test_feasible_step_is_climbed_with_all_four_wheels_on_top(stack):
+    stack.spawn_step(HEIGHT, DISTANCE, yaw=0.1)
+    response = stack.climb(HEIGHT, DISTANCE, yaw=0.1)
+    assert response.success, response.message
+    assert response.error_code == ClimbStep.Response.ERROR_NONE
+    stack.settle(0.5)
+    assert stack.four_wheels_on_top(HEIGHT), stack.truth
+    assert response.plan.swivel_angle != 0.0
+    assert 0.0 < response.outcome.peak_torque
+    assert response.outcome.distance_travelled > DISTANCE
+    # Released: the controller takes cmd_vel again.
+    assert stack.controller_state.source != 'swivel_command'
+
+
+@pytest.mark.parametrize('height, code', [
+    (0.5, ClimbStep.Response.ERROR_UNREACHABLE_HEIGHT),  # beyond the lifted wheel's reach
+    (0.08, ClimbStep.Response.ERROR_UNREACHABLE_HEIGHT),  # beyond the rear axle's traction
+    (-0.02, ClimbStep.Response.ERROR_INVALID_REQUEST)])
+def test_infeasible_step_is_refused_without_motion(stack, height, code):
+    if height > 0.0:
+        stack.spawn_step(height, DISTANCE)
+    before = stack.truth
+    response = stack.climb(height, DISTANCE)
+    assert not response.success
+    assert response.error_code == code, response.message
+    stack.settle(1.0)
+    after = stack.truth
+    assert math.hypot(after.x - before.x, after.y - before.y) < 0.002
+    assert after.speed < 0.01
+
+
+def test_second_goal_is_refused_and_cancel_stops_the_car_safely(stack):
+    stack.spawn_step(HEIGHT, DISTANCE)
+    feedback = []
+    goal = ClimbStepAction.Goal(step_height=HEIGHT, step_distance=DISTANCE)
+    sent = stack.climb_action.send_goal_async(
+        goal, feedback_callback=lambda msg: feedback.append(msg.feedback))
+    stack.spin_until(sent.done, 30.0, 'goal response')
+    handle = sent.result()
+    assert handle.accepted
+    stack.spin_until(lambda: feedback and feedback[-1].phase >= Phase.LIFT, 120.0,
+                     'the lift')
+    # A second goal and a service call meanwhile: both refused, the climb goes on.
+    second = stack.climb_action.send_goal_async(goal)
+    stack.spin_until(second.done, 30.0, 'second goal response')
+    assert not second.result().accepted
+    busy = stack.climb(HEIGHT, DISTANCE)
+    assert busy.error_code == ClimbStep.Response.ERROR_BUSY
+    stack.spin_until(lambda: feedback[-1].phase >= Phase.ADVANCE, 120.0, 'the advance')
+
+    cancel = handle.cancel_goal_async()
+    result = handle.get_result_async()
+    stack.spin_until(result.done, 60.0, 'the canceled result')
+    assert cancel.done()
+    assert result.result().status == GoalStatus.STATUS_CANCELED, result.result().result.message
+    assert result.result().result.error_code == ErrorCode.CANCELED
+    held = stack.controller_state
+    stack.settle(1.0)
+    truth = stack.truth
+    assert truth.speed < 0.02  # stopped
+    state = stack.controller_state
+    assert state.source == 'swivel_command' and state.drive_speed == pytest.approx(0.0)
+    assert state.target == pytest.approx(held.target, abs=0.05)  # swivel held
+    assert abs(state.measured) > 0.1  # still holding the wheel up, not dropped

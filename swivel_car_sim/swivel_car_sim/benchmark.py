@@ -1,0 +1,198 @@
+"""Speed of the sim: ``python -m swivel_car_sim.benchmark [--seconds 5]``.
+
+Prints, from one run on this machine:
+
+1. raw pybullet stepping of the same world and URDF (stepSimulation only);
+2. the physics core, SwivelCarSim.step (drive train torques and the watchdog every step);
+3. the sim node spun in this process with real_time_factor 0, publishing /clock,
+   joint_states, imu and ground_truth/odom every control period, first with no subscriber,
+   then to a Python subscriber of each in another process (which cannot keep up with
+   2000 messages/s, so the publisher also pays for reliable-QoS repairs);
+4. the installed sim_node executable in its own process (real_time_factor 0), its speed seen
+   through /clock by this process (which then also pays for receiving the clock).
+
+Real-time factor = sim time / wall time. Node overhead = extra wall time per sim second of
+(3) over (1), as a fraction of (1). Targets: RTF >= 20, overhead < 30 %.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import subprocess
+import sys
+import time
+
+from ament_index_python.packages import get_package_prefix
+
+import pybullet
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Imu, JointState
+
+from swivel_car_sim.physics import SwivelCarSim
+from swivel_car_sim.sim_node import SimNode
+
+TIME_STEP = 0.002  # [s]
+DOMAIN = 97  # ROS domain of the benchmark's nodes, away from the tests' 1..100 spread
+TOPICS = ((Clock, '/clock'), (JointState, 'joint_states'), (Imu, 'imu'),
+          (Odometry, 'ground_truth/odom'))
+
+
+def _rates(sim_seconds: float, wall_start: float, cpu_start: float) -> tuple[float, float]:
+    """Real-time factor per wall second and per CPU second of this process (the latter
+    does not depend on what else runs on the machine)."""
+    return (sim_seconds / (time.perf_counter() - wall_start),
+            sim_seconds / (time.process_time() - cpu_start))
+
+
+def raw_pybullet_rtf(seconds: float) -> tuple[float, float]:
+    """Sim seconds per wall and CPU second of bare stepSimulation on the same world and URDF
+    (no joint motors: pybullet's velocity motors add solver rows and cost more than the
+    drive train's torques)."""
+    with SwivelCarSim() as sim:
+        steps, start, cpu = 0, time.perf_counter(), time.process_time()
+        while time.perf_counter() - start < seconds:
+            pybullet.stepSimulation(physicsClientId=sim._client)
+            steps += 1
+        return _rates(steps * TIME_STEP, start, cpu)
+
+
+def core_rtf(seconds: float) -> tuple[float, float]:
+    """Sim seconds per wall second of SwivelCarSim, one control period per call."""
+    with SwivelCarSim() as sim:
+        start, cpu = time.perf_counter(), time.process_time()
+        while time.perf_counter() - start < seconds:
+            sim.set_command(0.0, 3.0)
+            sim.step(5)
+            sim.state()
+        return _rates(sim.time, start, cpu)
+
+
+def _listen(domain: int) -> None:
+    """Subscribe to everything the sim publishes until interrupted (the --listen mode)."""
+    rclpy.init(domain_id=domain)
+    node = Node('benchmark_listener')
+    for kind, topic in TOPICS:
+        node.create_subscription(kind, topic, lambda _: None, 10)
+    try:
+        rclpy.spin(node)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def _start_listener(domain: int) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, '-m', 'swivel_car_sim.benchmark', '--listen',
+                             str(domain)], env=_environment(domain),
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def _environment(domain: int) -> dict[str, str]:
+    return dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+
+
+def node_rtf(seconds: float, listener: bool) -> tuple[float, float]:
+    """Sim seconds per wall and per CPU second of the sim node spun in this process (as
+    rclpy.spin would), optionally with another process subscribed to all its topics."""
+    listener = _start_listener(DOMAIN) if listener else None
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=DOMAIN)
+    sim = SimNode(context=context, parameter_overrides=[
+        rclpy.parameter.Parameter('real_time_factor', value=0.0),
+        rclpy.parameter.Parameter('start_paused', value=True)])
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(sim)
+    try:
+        deadline = time.perf_counter() + 20.0
+        while (listener and any(sim.count_subscribers(topic) == 0 for _, topic in TOPICS)
+               and time.perf_counter() < deadline):
+            executor.spin_once(timeout_sec=0.05)
+        sim._paused = False
+        start_time, start, cpu = sim.sim.time, time.perf_counter(), time.process_time()
+        while time.perf_counter() - start < seconds:
+            executor.spin_once(timeout_sec=0.1)
+        return _rates(sim.sim.time - start_time, start, cpu)
+    finally:
+        executor.shutdown()
+        sim.destroy_node()
+        rclpy.try_shutdown(context=context)
+        if listener:
+            listener.send_signal(signal.SIGINT)
+            listener.wait(10)
+
+
+def process_rtf(seconds: float) -> float | None:
+    """Sim seconds per wall second of the installed sim_node process, seen through /clock."""
+    try:
+        executable = os.path.join(get_package_prefix('swivel_car_sim'), 'lib', 'swivel_car_sim',
+                                  'sim_node')
+    except Exception:  # noqa: BLE001 - not installed: skip this figure
+        return None
+    process = subprocess.Popen([executable, '--ros-args', '-p', 'real_time_factor:=0.0'],
+                               env=_environment(DOMAIN), stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=DOMAIN)
+    node = Node('benchmark_clock', context=context)
+    stamps: list[tuple[float, float]] = []
+    node.create_subscription(
+        Clock, '/clock',
+        lambda m: stamps.append((time.perf_counter(), m.clock.sec + m.clock.nanosec * 1e-9)), 10)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    try:
+        deadline = time.perf_counter() + 20.0
+        while len(stamps) < 10 and time.perf_counter() < deadline:
+            executor.spin_once(timeout_sec=0.1)
+        stamps.clear()
+        start = time.perf_counter()
+        while time.perf_counter() - start < seconds:
+            executor.spin_once(timeout_sec=0.1)
+        if len(stamps) < 2:
+            return None
+        return (stamps[-1][1] - stamps[0][1]) / (stamps[-1][0] - stamps[0][0])
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+        process.send_signal(signal.SIGINT)
+        process.wait(10)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--seconds', type=float, default=5.0, help='wall time per figure')
+    parser.add_argument('--listen', type=int, metavar='DOMAIN', help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.listen is not None:
+        _listen(args.listen)
+        return
+    raw = raw_pybullet_rtf(args.seconds)
+    core = core_rtf(args.seconds)
+    alone = node_rtf(args.seconds, listener=False)
+    node = node_rtf(args.seconds, listener=True)
+    process = process_rtf(args.seconds)
+    print(f'load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; real-time factor '
+          'per wall second and per CPU second of this process; overhead = extra CPU per sim '
+          'second over raw stepping')
+    print(f'raw pybullet stepSimulation : wall {raw[0]:6.1f}x  cpu {raw[1]:6.1f}x')
+    print(f'physics core (SwivelCarSim) : wall {core[0]:6.1f}x  cpu {core[1]:6.1f}x  '
+          f'overhead {raw[1] / core[1] - 1.0:+.0%}')
+    print(f'sim node, no subscribers    : wall {alone[0]:6.1f}x  cpu {alone[1]:6.1f}x  '
+          f'overhead {raw[1] / alone[1] - 1.0:+.0%}  (targets: >= 20x, < +30 %)')
+    print(f'sim node, all topics heard  : wall {node[0]:6.1f}x  cpu {node[1]:6.1f}x  '
+          f'overhead {raw[1] / node[1] - 1.0:+.0%}  (a Python subscriber of all four topics '
+          'in another process)')
+    if process is not None:
+        print(f'sim_node process on /clock  : wall {process:6.1f}x')
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,123 @@
+"""The sim node's parameters: one table (name, default, description) and the validated,
+frozen configuration read from it. ROS-free."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from swivel_car_model.params import SwivelCarParams
+from swivel_car_sim.physics import SimConfig
+
+_DEFAULT_GEOMETRY = SwivelCarParams()
+
+# name -> (default, description). The node declares exactly these.
+PARAMETERS: dict[str, tuple[object, str]] = {
+    'gui': (False, 'open the pybullet GUI window (needs a display)'),
+    'time_step': (0.002, '[s] physics step'),
+    'control_period': (0.01, '[s] joint_states/imu/odom period and lockstep advance; a '
+                             'multiple of time_step'),
+    'real_time_factor': (1.0, '[1] sim time per wall time when free running; 0 = as fast '
+                              'as possible'),
+    'lockstep': (False, 'advance one control_period per ActuatorCommand stamped with the '
+                        'last joint_states stamp'),
+    'lockstep_timeout': (1.0, '[s] wall time to wait for the command in lockstep before '
+                              'advancing anyway; 0 = wait forever'),
+    'watchdog_timeout': (0.5, '[s] sim time without a command after which the swivel torque '
+                              'is zeroed and the drive stops; 0 disables'),
+    'robot_variant': ('swivel', "'swivel' or 'car_like' (baseline with a steered front axle)"),
+    'l': (_DEFAULT_GEOMETRY.l, '[m] length of each T column'),
+    'h': (_DEFAULT_GEOMETRY.h, '[m] half wheel shaft: wheel plane to column'),
+    'phi': (_DEFAULT_GEOMETRY.phi, '[rad] angle between the T columns (thesis phi)'),
+    'r': (_DEFAULT_GEOMETRY.r, '[m] wheel radius'),
+    'mass': (_DEFAULT_GEOMETRY.mass, '[kg] total mass'),
+    'initial_x': (0.0, '[m] initial base_link x in the world'),
+    'initial_y': (0.0, '[m] initial base_link y in the world'),
+    'initial_yaw': (0.0, '[rad] initial heading'),
+    'start_paused': (False, 'start with the physics paused (~/set_paused false resumes)'),
+    'imu_rate': (100.0, '[Hz] imu publish rate; control_period divided by a whole number'),
+    'ground_truth_rate': (100.0, '[Hz] ground_truth/odom publish rate; as imu_rate'),
+    'swivel_torque_limit': (40.0, '[N m] largest |swivel torque| applied'),
+    'drive_torque_limit': (10.0, '[N m] largest |total drive torque at the wheels|'),
+    'drive_speed_limit': (20.0, '[rad/s] largest |drive speed at the wheels|'),
+    'ground_friction': (1.0, '[1] friction coefficient of the ground'),
+    'wheel_friction': (1.0, '[1] friction coefficient of the tyres'),
+}
+
+
+@dataclass(frozen=True)
+class SimNodeConfig:
+    """Everything the sim node reads from its parameters, validated.
+
+    Attributes mirror ``PARAMETERS``; ``physics`` is the SimConfig built from them,
+    ``steps_per_period`` the physics steps per control period and ``imu_every`` /
+    ``ground_truth_every`` the number of control periods between those messages.
+    """
+
+    physics: SimConfig
+    control_period: float  # [s]
+    steps_per_period: int  # [1]
+    real_time_factor: float  # [1]
+    lockstep: bool
+    lockstep_timeout: float  # [s]
+    initial_pose: tuple[float, float, float]  # [m], [m], [rad]
+    start_paused: bool
+    imu_every: int  # [1]
+    ground_truth_every: int  # [1]
+
+    @classmethod
+    def from_values(cls, values: dict[str, object]) -> 'SimNodeConfig':
+        """Build from parameter values (missing ones take their default).
+
+        Raises
+        ------
+        ValueError
+            A value is of the wrong type or out of range; the message names it.
+        """
+        v = {name: values.get(name, default) for name, (default, _) in PARAMETERS.items()}
+        for name, (default, _) in PARAMETERS.items():
+            value = v[name]
+            if isinstance(default, bool):
+                if not isinstance(value, bool):
+                    raise ValueError(f'{name} must be a bool, got {value!r}')
+            elif isinstance(default, float):
+                if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                        or not math.isfinite(value):
+                    raise ValueError(f'{name} must be a finite number, got {value!r}')
+                v[name] = float(value)
+            elif not isinstance(value, str):
+                raise ValueError(f'{name} must be a string, got {value!r}')
+        geometry = SwivelCarParams(l=v['l'], h=v['h'], phi=v['phi'], r=v['r'], mass=v['mass'])
+        physics = SimConfig(
+            params=geometry, robot_variant=v['robot_variant'], time_step=v['time_step'],
+            gui=v['gui'], swivel_torque_limit=v['swivel_torque_limit'],
+            drive_torque_limit=v['drive_torque_limit'],
+            drive_speed_limit=v['drive_speed_limit'], watchdog_timeout=v['watchdog_timeout'],
+            ground_friction=v['ground_friction'], wheel_friction=v['wheel_friction'])
+        steps = _whole_ratio(v['control_period'], physics.time_step, 'control_period',
+                             'time_step')
+        if v['real_time_factor'] < 0.0:
+            raise ValueError(f'real_time_factor must be >= 0, got {v["real_time_factor"]!r}')
+        if v['lockstep_timeout'] < 0.0:
+            raise ValueError(f'lockstep_timeout must be >= 0, got {v["lockstep_timeout"]!r}')
+        every = {}
+        for name in ('imu_rate', 'ground_truth_rate'):
+            if v[name] <= 0.0:
+                raise ValueError(f'{name} must be > 0, got {v[name]!r}')
+            every[name] = _whole_ratio(1.0 / v[name], v['control_period'], f'1/{name}',
+                                       'control_period')
+        return cls(physics=physics, control_period=v['control_period'],
+                   steps_per_period=steps, real_time_factor=v['real_time_factor'],
+                   lockstep=v['lockstep'], lockstep_timeout=v['lockstep_timeout'],
+                   initial_pose=(v['initial_x'], v['initial_y'], v['initial_yaw']),
+                   start_paused=v['start_paused'], imu_every=every['imu_rate'],
+                   ground_truth_every=every['ground_truth_rate'])
+
+
+def _whole_ratio(numerator: float, denominator: float, name: str, of: str) -> int:
+    ratio = numerator / denominator
+    whole = round(ratio)
+    if whole < 1 or abs(ratio - whole) > 1e-6 * max(1.0, ratio):
+        raise ValueError(f'{name} ({numerator!r}) must be a whole multiple (>= 1) of {of} '
+                         f'({denominator!r})')
+    return whole

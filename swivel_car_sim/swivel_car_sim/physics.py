@@ -1,0 +1,533 @@
+"""The simulated swivel car: a pybullet world with the robot, its drive train and step obstacles.
+
+ROS-free. ``SwivelCarSim`` owns one pybullet client (DIRECT unless ``gui``), steps it at a
+fixed ``time_step`` and exposes what a motor driver board and an IMU would: joint states, base
+orientation, angular velocity and specific force, plus the ground truth pose and twist.
+
+Drive train (one motor, an open differential per axle, front and rear carriers coupled rigidly).
+pybullet's gear constraints couple two joints, not the three bodies of a differential, so the
+torques are computed every physics step and applied with TORQUE_CONTROL:
+
+* the motor is speed controlled with a torque limit: a PI loop on the rear carrier speed
+  (mean of the two rear wheel speeds, the motor's shaft through the rear differential),
+  ``T_m = sat(K_p e + K_i integral(e))``, the integral frozen while saturated;
+* the shaft to the front differential is stiff but not infinitely so (explicit torques in a
+  0.002 s step cannot be): a torsional spring-damper between the rear and front carrier angles,
+  ``T_f = K_s (theta_r - theta_f) + K_d (omega_r - omega_f)``, so the carrier speeds stay equal
+  on average and the wind-up stays small (about 0.06 rad at 10 N m);
+* each differential is open: both wheels of an axle get half the axle's torque (front
+  ``T_f``, rear ``T_m - T_f``), their speeds free to differ.
+
+The gains follow from the wheel inertia and the time step so that the worst case, an axle with
+both wheels in the air, is still well damped; their values are in ``DriveGains``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+
+import numpy as np
+import pybullet
+
+from swivel_car_model.params import SwivelCarParams
+from swivel_car_sim.urdf import build_robot, RobotDescription, ROBOT_VARIANTS
+
+GRAVITY = 9.81  # [m/s^2]
+MAX_STEPS_PER_CALL = 100_000
+# Without URDF_USE_IMPLICIT_CYLINDER pybullet turns URDF cylinders into polygonal hulls and the
+# wheels bump over their facets (the body hopped 0.4 mm every facet, the IMU's vertical
+# specific force had a 3.4 m/s^2 standard deviation at 0.37 m/s).
+URDF_FLAGS = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CYLINDER
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """Configuration of a SwivelCarSim; validated on construction.
+
+    Parameters
+    ----------
+    params : SwivelCarParams
+        Robot geometry and masses.
+    robot_variant : str
+        'swivel' or 'car_like'.
+    time_step : float
+        Physics step. # [s]
+    gui : bool
+        Open the pybullet GUI (needs a display) instead of DIRECT.
+    swivel_torque_limit : float
+        Largest |swivel torque| applied. # [N m]
+    drive_torque_limit : float
+        Largest |total drive torque at the wheels|. # [N m]
+    drive_speed_limit : float
+        Largest |drive speed at the wheels|. # [rad/s]
+    watchdog_timeout : float
+        Sim time without a command after which the swivel torque is zeroed and the drive
+        commanded to stop; 0 disables the watchdog. # [s]
+    ground_friction, wheel_friction : float
+        Coulomb friction coefficients (pybullet combines them by product). # [1]
+    """
+
+    params: SwivelCarParams = field(default_factory=SwivelCarParams)
+    robot_variant: str = 'swivel'
+    time_step: float = 0.002  # [s]
+    gui: bool = False
+    swivel_torque_limit: float = 40.0  # [N m]
+    drive_torque_limit: float = 10.0  # [N m]
+    drive_speed_limit: float = 20.0  # [rad/s]
+    watchdog_timeout: float = 0.5  # [s]
+    ground_friction: float = 1.0  # [1]
+    wheel_friction: float = 1.0  # [1]
+
+    def __post_init__(self) -> None:
+        if self.robot_variant not in ROBOT_VARIANTS:
+            raise ValueError(
+                f'robot_variant must be one of {ROBOT_VARIANTS}, got {self.robot_variant!r}')
+        _require(0.0 < self.time_step <= 0.01, 'time_step', self.time_step, 'in (0, 0.01] s')
+        for name in ('swivel_torque_limit', 'drive_torque_limit', 'drive_speed_limit',
+                     'ground_friction', 'wheel_friction'):
+            _require(getattr(self, name) > 0.0, name, getattr(self, name), '> 0')
+        _require(self.watchdog_timeout >= 0.0, 'watchdog_timeout', self.watchdog_timeout, '>= 0')
+
+
+def _require(ok: bool, name: str, value, what: str) -> None:
+    if not isinstance(value, (int, float)) or not math.isfinite(value) or not ok:
+        raise ValueError(f'{name} must be finite and {what}, got {value!r}')
+
+
+@dataclass(frozen=True)
+class DriveGains:
+    """Gains of the drive train model (see the module docstring).
+
+    Attributes
+    ----------
+    speed_p : float  # [N m s/rad]
+    speed_i : float  # [N m/rad]
+    shaft_stiffness : float  # [N m/rad]
+    shaft_damping : float  # [N m s/rad]
+    """
+
+    speed_p: float
+    speed_i: float
+    shaft_stiffness: float
+    shaft_damping: float
+
+    @classmethod
+    def for_robot(cls, params: SwivelCarParams, time_step: float) -> 'DriveGains':
+        """Gains that keep a carrier with both wheels in the air (inertia 2 I_w) stable and
+        well damped, and give the loaded speed loop (the whole car on the rear carrier)
+        a damping ratio near 0.7."""
+        wheel_inertia = params.wheel_mass * params.r ** 2 / 2.0  # [kg m^2] about the axle
+        free_carrier = 2.0 * wheel_inertia
+        loaded_carrier = params.mass * params.r ** 2 + 4.0 * wheel_inertia
+        speed_p = free_carrier / time_step  # dead-beat for the free carrier
+        speed_i = (speed_p / (2.0 * 0.7)) ** 2 / loaded_carrier
+        stiffness = 0.25 * free_carrier / time_step ** 2
+        damping = 2.0 * 0.7 * math.sqrt(stiffness * free_carrier)
+        return cls(speed_p, speed_i, stiffness, damping)
+
+
+@dataclass(frozen=True)
+class StepSpec:
+    """A rectangular step, relative to base_link at the time of the request
+    (see swivel_car_msgs/msg/StepObstacle.msg for the meaning of each field)."""
+
+    name: str
+    height: float  # [m]
+    depth: float  # [m]
+    width: float  # [m]
+    distance: float  # [m]
+    yaw: float  # [rad]
+    friction: float  # [1]
+
+    def validate(self) -> None:
+        """Raise ValueError naming the first bad field."""
+        for name in ('height', 'depth', 'width', 'distance', 'yaw', 'friction'):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ValueError(f'{name} must be finite, got {value!r}')
+        if not 0.0 < self.height <= 1.0:
+            raise ValueError(f'height must be in (0, 1] m, got {self.height!r}')
+        for name in ('depth', 'width'):
+            if not 0.0 < getattr(self, name) <= 20.0:
+                raise ValueError(f'{name} must be in (0, 20] m, got {getattr(self, name)!r}')
+        if self.distance < 0.0:
+            raise ValueError(f'distance must be >= 0 m, got {self.distance!r}')
+        if not -math.pi / 2.0 < self.yaw < math.pi / 2.0:
+            raise ValueError(f'yaw must be in (-pi/2, pi/2) rad, got {self.yaw!r}')
+        if not 0.0 < self.friction <= 10.0:
+            raise ValueError(f'friction must be in (0, 10], got {self.friction!r}')
+
+
+@dataclass(frozen=True)
+class RobotState:
+    """What the sensors and the ground truth report at one instant.
+
+    Attributes
+    ----------
+    time : float  # [s] sim time
+    joint_names : tuple of str  # steer joint, then the four wheel joints
+    positions : numpy.ndarray  # [rad]
+    velocities : numpy.ndarray  # [rad/s]
+    efforts : numpy.ndarray  # [N m] torques applied during the last step
+    position : numpy.ndarray  # [m] base_link origin in the world
+    orientation : numpy.ndarray  # [1] base_link orientation, quaternion x, y, z, w
+    linear_velocity : numpy.ndarray  # [m/s] base_link origin velocity, in base_link
+    angular_velocity : numpy.ndarray  # [rad/s] in base_link
+    linear_acceleration : numpy.ndarray  # [m/s^2] specific force (IMU), in base_link
+    """
+
+    time: float
+    joint_names: tuple[str, ...]
+    positions: np.ndarray
+    velocities: np.ndarray
+    efforts: np.ndarray
+    position: np.ndarray
+    orientation: np.ndarray
+    linear_velocity: np.ndarray
+    angular_velocity: np.ndarray
+    linear_acceleration: np.ndarray
+
+    @property
+    def yaw(self) -> float:
+        """Heading of base_link about the world z axis. # [rad]"""
+        x, y, z, w = self.orientation
+        return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+    @property
+    def pitch(self) -> float:
+        """Pitch of base_link, positive nose down (REP-103 rotation about y). # [rad]"""
+        x, y, z, w = self.orientation
+        return math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+
+
+class SwivelCarSim:
+    """A pybullet world holding one swivel car (or car-like baseline) and step obstacles.
+
+    Parameters
+    ----------
+    config : SimConfig
+    initial_pose : tuple of float
+        (x [m], y [m], yaw [rad]) of base_link on the ground.
+
+    Notes
+    -----
+    Deterministic: the same sequence of calls gives the same states. Sim time only moves
+    forward (``reset`` keeps it), so ROS clocks fed from it never jump back.
+    """
+
+    def __init__(self, config: SimConfig | None = None,
+                 initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None:
+        self.config = config or SimConfig()
+        self.robot: RobotDescription = build_robot(self.config.params, self.config.robot_variant)
+        self.gains = DriveGains.for_robot(self.config.params, self.config.time_step)
+        self._client = pybullet.connect(pybullet.GUI if self.config.gui else pybullet.DIRECT)
+        if self._client < 0:
+            raise RuntimeError('pybullet could not connect' + (' a GUI (is there a display?)'
+                                                               if self.config.gui else ''))
+        self._pb = _Client(self._client)
+        self._pb.setPhysicsEngineParameter(fixedTimeStep=self.config.time_step,
+                                           enableFileCaching=0, deterministicOverlappingPairs=1)
+        self._pb.setGravity(0.0, 0.0, -GRAVITY)
+        plane = self._pb.createCollisionShape(pybullet.GEOM_PLANE)
+        self._ground = self._pb.createMultiBody(0.0, plane)
+        self._pb.changeDynamics(self._ground, -1, lateralFriction=self.config.ground_friction)
+        fd, self._urdf_path = tempfile.mkstemp(prefix='swivel_car_', suffix='.urdf')
+        with os.fdopen(fd, 'w') as f:
+            f.write(self.robot.urdf)
+        self._steps = 0
+        self._obstacles: dict[str, int] = {}
+        self._obstacle_counter = 0
+        self._body = -1
+        self._load_robot(*initial_pose)
+
+    # --- lifecycle -------------------------------------------------------------------------
+
+    def close(self) -> None:
+        """Disconnect pybullet and delete the temporary URDF. Idempotent."""
+        if self._client >= 0:
+            pybullet.disconnect(physicsClientId=self._client)
+            self._client = -1
+            os.unlink(self._urdf_path)
+
+    def __enter__(self) -> 'SwivelCarSim':
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # --- time and stepping -----------------------------------------------------------------
+
+    @property
+    def steps(self) -> int:
+        """Physics steps taken since construction. # [1]"""
+        return self._steps
+
+    @property
+    def time(self) -> float:
+        """Sim time. # [s]"""
+        return self._steps * self.config.time_step
+
+    def set_command(self, swivel_torque: float, drive_speed: float) -> None:
+        """Take an actuator command (clamped to the limits); it feeds the watchdog.
+
+        Raises
+        ------
+        ValueError
+            A field is not finite; the previous command stays.
+        """
+        for name, value in (('swivel_torque', swivel_torque), ('drive_speed', drive_speed)):
+            if not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ValueError(f'{name} must be finite, got {value!r}')
+        c = self.config
+        self._swivel_torque = min(c.swivel_torque_limit, max(-c.swivel_torque_limit,
+                                                              float(swivel_torque)))
+        self._drive_speed = min(c.drive_speed_limit, max(-c.drive_speed_limit,
+                                                          float(drive_speed)))
+        self._command_time = self.time
+
+    @property
+    def watchdog_tripped(self) -> bool:
+        """True while the last command is older than the watchdog timeout."""
+        timeout = self.config.watchdog_timeout
+        return timeout > 0.0 and self.time - self._command_time > timeout + 1e-9
+
+    def step(self, steps: int = 1) -> None:
+        """Advance the physics by ``steps`` time steps (1 .. 100000)."""
+        if not isinstance(steps, int) or not 1 <= steps <= MAX_STEPS_PER_CALL:
+            raise ValueError(f'steps must be an integer in [1, {MAX_STEPS_PER_CALL}], '
+                             f'got {steps!r}')
+        v_start = self._base_velocity_world()[0]
+        for _ in range(steps):
+            self._apply_actuators()
+            pybullet.stepSimulation(physicsClientId=self._client)
+            self._steps += 1
+        v_end = self._base_velocity_world()[0]
+        self._acceleration = (v_end - v_start) / (steps * self.config.time_step)
+
+    def _apply_actuators(self) -> None:
+        # The hot loop (every physics step): plain floats and direct pybullet calls, since
+        # numpy on four numbers costs more than the physics step itself.
+        g = self.gains
+        dt = self.config.time_step
+        rl, rr, fl, fr = pybullet.getJointStates(self._body, self._wheel_ids,
+                                                 physicsClientId=self._client)
+        if self.watchdog_tripped:
+            swivel_torque, drive_speed = 0.0, 0.0
+        else:
+            swivel_torque, drive_speed = self._swivel_torque, self._drive_speed
+        rear_speed, front_speed = (rl[1] + rr[1]) / 2.0, (fl[1] + fr[1]) / 2.0
+        error = drive_speed - rear_speed
+        limit = self.config.drive_torque_limit
+        unsaturated = g.speed_p * error + g.speed_i * (self._speed_integral + error * dt)
+        motor = min(limit, max(-limit, unsaturated))
+        if motor == unsaturated:
+            self._speed_integral += error * dt
+        front = (g.shaft_stiffness * ((rl[0] + rr[0]) - (fl[0] + fr[0])) / 2.0
+                 + g.shaft_damping * (rear_speed - front_speed))
+        rear = motor - front
+        self._efforts = [swivel_torque, rear / 2.0, rear / 2.0, front / 2.0, front / 2.0]
+        pybullet.setJointMotorControlArray(self._body, self._joint_ids, pybullet.TORQUE_CONTROL,
+                                           forces=self._efforts, physicsClientId=self._client)
+
+    # --- robot -----------------------------------------------------------------------------
+
+    def reset(self, x: float = 0.0, y: float = 0.0, yaw: float = 0.0,
+              remove_obstacles: bool = False) -> None:
+        """Put the robot at rest on the ground at (x, y, yaw), swivel at 0, command zero.
+
+        Raises
+        ------
+        ValueError
+            Non-finite pose, or the robot would overlap an obstacle; nothing changes.
+        """
+        for name, value in (('x', x), ('y', y), ('yaw', yaw)):
+            if not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ValueError(f'{name} must be finite, got {value!r}')
+        if not remove_obstacles:
+            blocking = self._obstacles_overlapping_robot_at(x, y, yaw)
+            if blocking:
+                raise ValueError(f'the robot at ({x}, {y}, {yaw}) would overlap obstacle(s) '
+                                 f'{", ".join(blocking)}')
+        if remove_obstacles:
+            self.remove_obstacle('')
+        self._pb.removeBody(self._body)
+        self._load_robot(x, y, yaw)
+
+    def _load_robot(self, x: float, y: float, yaw: float) -> None:
+        pb = self._pb
+        orientation = pybullet.getQuaternionFromEuler([0.0, 0.0, yaw])
+        self._body = pb.loadURDF(self._urdf_path, [x, y, self.config.params.r], orientation,
+                                 flags=URDF_FLAGS)
+        names = {pb.getJointInfo(self._body, i)[1].decode(): i
+                 for i in range(pb.getNumJoints(self._body))}
+        self.joint_names = (self.robot.steer_joint,) + self.robot.wheel_joints
+        self._joint_ids = [names[n] for n in self.joint_names]
+        self._wheel_ids = self._joint_ids[1:]
+        # Joint motors are on by default: switch them off so that torques act alone.
+        pb.setJointMotorControlArray(self._body, self._joint_ids, pybullet.VELOCITY_CONTROL,
+                                     forces=[0.0] * len(self._joint_ids))
+        for link in range(-1, pb.getNumJoints(self._body)):
+            pb.changeDynamics(self._body, link, lateralFriction=self.config.wheel_friction,
+                              linearDamping=0.0, angularDamping=0.0, jointDamping=0.0)
+        inertial = pb.getDynamicsInfo(self._body, -1)
+        self._com_in_link = (inertial[3], inertial[4])
+        self._link_in_com = pybullet.invertTransform(*self._com_in_link)
+        self._swivel_torque = 0.0
+        self._drive_speed = 0.0
+        self._command_time = self.time
+        self._speed_integral = 0.0
+        self._efforts = [0.0] * len(self._joint_ids)
+        self._acceleration = np.zeros(3)
+
+    def _base_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """base_link origin and orientation (pybullet reports the base's inertial frame)."""
+        com_pos, com_orn = self._pb.getBasePositionAndOrientation(self._body)
+        pos, orn = pybullet.multiplyTransforms(com_pos, com_orn, *self._link_in_com)
+        return np.array(pos), np.array(orn)
+
+    def _base_velocity_world(self) -> tuple[np.ndarray, np.ndarray]:
+        """base_link origin velocity and angular velocity in the world frame."""
+        com_pos, com_orn = self._pb.getBasePositionAndOrientation(self._body)
+        linear, angular = self._pb.getBaseVelocity(self._body)
+        pos, _ = pybullet.multiplyTransforms(com_pos, com_orn, *self._link_in_com)
+        # v_origin = v_com + omega x (origin - com)
+        dx, dy, dz = pos[0] - com_pos[0], pos[1] - com_pos[1], pos[2] - com_pos[2]
+        wx, wy, wz = angular
+        return (np.array([linear[0] + wy * dz - wz * dy, linear[1] + wz * dx - wx * dz,
+                          linear[2] + wx * dy - wy * dx]), np.array(angular))
+
+    def state(self) -> RobotState:
+        """The sensors and the ground truth now."""
+        states = self._pb.getJointStates(self._body, self._joint_ids)
+        pos, orn = self._base_pose()
+        rotation = np.array(pybullet.getMatrixFromQuaternion(orn)).reshape(3, 3)
+        linear, angular = self._base_velocity_world()
+        specific_force = self._acceleration + np.array([0.0, 0.0, GRAVITY])
+        return RobotState(
+            time=self.time, joint_names=self.joint_names,
+            positions=np.array([s[0] for s in states]),
+            velocities=np.array([s[1] for s in states]),
+            efforts=np.array(self._efforts), position=pos, orientation=orn,
+            linear_velocity=rotation.T @ linear, angular_velocity=rotation.T @ angular,
+            linear_acceleration=rotation.T @ specific_force)
+
+    def wheel_lowest_points(self) -> np.ndarray:
+        """Lowest point height of each wheel's rim circle (thin disc, as the thesis models
+        it), rear left, rear right, front left, front right. # [m]"""
+        heights = []
+        for joint in self._wheel_ids:
+            s = self._pb.getLinkState(self._body, joint, computeForwardKinematics=1)
+            axis = np.array(pybullet.getMatrixFromQuaternion(s[5])).reshape(3, 3)[:, 1]
+            # Lowest rim point: centre minus r times the unit vector of -z orthogonal to axis.
+            down = np.array([0.0, 0.0, -1.0]) - axis * -axis[2]
+            norm = np.linalg.norm(down)
+            heights.append(s[4][2] + (self.config.params.r * down[2] / norm if norm > 1e-9
+                                      else 0.0))
+        return np.array(heights)
+
+    # --- obstacles -------------------------------------------------------------------------
+
+    @property
+    def obstacle_names(self) -> tuple[str, ...]:
+        return tuple(self._obstacles)
+
+    def spawn_obstacle(self, spec: StepSpec) -> str:
+        """Add a step in front of the robot; returns its name.
+
+        Raises
+        ------
+        ValueError
+            Invalid field, duplicate name, or the box would overlap the robot; the world is
+            unchanged.
+        """
+        spec.validate()
+        name = spec.name or self._next_obstacle_name()
+        if name in self._obstacles:
+            raise ValueError(f'an obstacle named {name!r} exists already')
+        position, orientation, half = self._step_placement(spec)
+        pb = self._pb
+        shape = pb.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half.tolist())
+        if pb.getClosestPoints(bodyA=self._body, bodyB=-1, distance=0.0, collisionShapeB=shape,
+                               collisionShapePositionB=position.tolist(),
+                               collisionShapeOrientationB=orientation):
+            pb.removeCollisionShape(shape)
+            raise ValueError(f'obstacle {name!r} would overlap the robot (distance '
+                             f'{spec.distance} m, yaw {spec.yaw} rad)')
+        visual = pb.createVisualShape(pybullet.GEOM_BOX, halfExtents=half.tolist(),
+                                      rgbaColor=[0.5, 0.5, 0.8, 1.0])
+        body = pb.createMultiBody(0.0, shape, visual, position.tolist(), orientation)
+        pb.changeDynamics(body, -1, lateralFriction=spec.friction)
+        self._obstacles[name] = body
+        if not spec.name:
+            self._obstacle_counter += 1
+        return name
+
+    def _next_obstacle_name(self) -> str:
+        counter = self._obstacle_counter
+        while f'step_{counter}' in self._obstacles:
+            counter += 1
+        self._obstacle_counter = counter
+        return f'step_{counter}'
+
+    def _step_placement(self, spec: StepSpec):
+        """Centre, orientation and half extents of the box of ``spec``."""
+        base_pos, base_orn = self._base_pose()
+        rotation = np.array(pybullet.getMatrixFromQuaternion(base_orn)).reshape(3, 3)
+        heading = math.atan2(rotation[1, 0], rotation[0, 0])
+        contact = base_pos + rotation @ self.config.params.front_axle
+        direction = np.array([math.cos(heading), math.sin(heading), 0.0])
+        normal_yaw = heading + spec.yaw
+        normal = np.array([math.cos(normal_yaw), math.sin(normal_yaw), 0.0])
+        edge = np.array([contact[0], contact[1], 0.0]) + spec.distance * direction
+        centre = edge + normal * spec.depth / 2.0 + np.array([0.0, 0.0, spec.height / 2.0])
+        orientation = pybullet.getQuaternionFromEuler([0.0, 0.0, normal_yaw])
+        return centre, orientation, np.array([spec.depth, spec.width, spec.height]) / 2.0
+
+    def _obstacles_overlapping_robot_at(self, x: float, y: float, yaw: float) -> list[str]:
+        """Names of obstacles the robot, placed at rest at (x, y, yaw), would touch."""
+        if not self._obstacles:
+            return []
+        pb = self._pb
+        probe = pb.loadURDF(self._urdf_path, [x, y, self.config.params.r],
+                            pybullet.getQuaternionFromEuler([0.0, 0.0, yaw]), flags=URDF_FLAGS)
+        try:
+            return [name for name, body in self._obstacles.items()
+                    if pb.getClosestPoints(probe, body, 0.0)]
+        finally:
+            pb.removeBody(probe)
+
+    def remove_obstacle(self, name: str) -> None:
+        """Remove the obstacle ``name``; the empty name removes all.
+
+        Raises
+        ------
+        ValueError
+            No obstacle of that name.
+        """
+        if name == '':
+            for body in self._obstacles.values():
+                self._pb.removeBody(body)
+            self._obstacles.clear()
+            return
+        if name not in self._obstacles:
+            raise ValueError(f'no obstacle named {name!r} (have: {sorted(self._obstacles)})')
+        self._pb.removeBody(self._obstacles.pop(name))
+
+
+class _Client:
+    """pybullet functions bound to one physics client."""
+
+    def __init__(self, client: int) -> None:
+        self._client = client
+
+    def __getattr__(self, name: str):
+        function = getattr(pybullet, name)
+
+        def bound(*args, **kwargs):
+            return function(*args, physicsClientId=self._client, **kwargs)
+        bound.__name__ = name
+        setattr(self, name, bound)
+        return bound

@@ -1,0 +1,237 @@
+"""The sim node: the pybullet swivel car behind the topics a motor driver board and an IMU
+would offer, owner of /clock, with a deterministic lockstep mode (docs/architecture.md)."""
+
+from __future__ import annotations
+
+import time
+
+import rclpy
+from rclpy.clock import Clock, ClockType
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rcl_interfaces.msg import ParameterDescriptor
+from rosgraph_msgs.msg import Clock as ClockMsg
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import Imu, JointState
+from std_srvs.srv import SetBool
+from swivel_car_msgs.msg import ActuatorCommand
+from swivel_car_msgs.srv import (RemoveObstacle, ResetSimulation, SpawnObstacle,
+                                 StepSimulation)
+
+from swivel_car_sim.config import PARAMETERS, SimNodeConfig
+from swivel_car_sim.conversions import sim_time_msg, StateMessages
+from swivel_car_sim.physics import MAX_STEPS_PER_CALL, StepSpec, SwivelCarSim
+
+# With real_time_factor 0 one timer callback steps for at most this long, then yields to
+# the executor so that commands and service calls are never starved.
+FAST_BATCH_WALL_TIME = 0.005  # [s]
+# In lockstep the state is published again while no command comes, so that a controller
+# started after the sim (or a lost message) still gets the state it must answer.
+LOCKSTEP_REPUBLISH_PERIOD = 0.1  # [s] wall
+
+
+class SimNode(Node):
+    """pybullet simulation of the swivel car (see the package README for the interface)."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('sim', **kwargs)
+        for name, (default, description) in PARAMETERS.items():
+            self.declare_parameter(name, default, ParameterDescriptor(description=description))
+        try:
+            self.config = SimNodeConfig.from_values(
+                {name: self.get_parameter(name).value for name in PARAMETERS})
+        except ValueError as error:
+            raise ValueError(f'sim: invalid parameter: {error}') from error
+        cfg = self.config
+        self.sim = SwivelCarSim(cfg.physics, cfg.initial_pose)
+        self._time_step_ns = round(cfg.physics.time_step * 1e9)
+        self._paused = cfg.start_paused
+        self._command_ready = False
+        self._periods = 0
+        self._period_start_wall = self._last_publish_wall = time.monotonic()
+        self._messages = StateMessages(self.sim.joint_names)
+
+        self._clock_pub = self.create_publisher(ClockMsg, '/clock', 10)
+        self._joint_pub = self.create_publisher(JointState, 'joint_states', 10)
+        self._imu_pub = self.create_publisher(Imu, 'imu', 10)
+        self._odom_pub = self.create_publisher(Odometry, 'ground_truth/odom', 10)
+        self.create_subscription(ActuatorCommand, 'actuator_command', self._on_command, 10)
+        self.create_service(ResetSimulation, '~/reset', self._on_reset)
+        self.create_service(SetBool, '~/set_paused', self._on_set_paused)
+        self.create_service(StepSimulation, '~/step', self._on_step)
+        self.create_service(SpawnObstacle, '~/spawn_obstacle', self._on_spawn)
+        self.create_service(RemoveObstacle, '~/remove_obstacle', self._on_remove)
+
+        wall = Clock(clock_type=ClockType.STEADY_TIME)
+        if cfg.lockstep:
+            period = 0.02 if cfg.lockstep_timeout == 0.0 else min(0.02, cfg.lockstep_timeout / 4)
+            self.create_timer(period, self._on_lockstep_timer, clock=wall)
+        elif cfg.real_time_factor > 0.0:
+            self.create_timer(cfg.control_period / cfg.real_time_factor, self._advance_if_running,
+                              clock=wall)
+        else:
+            self.create_timer(0.0, self._on_fast_timer, clock=wall)
+        self._publish_state()
+        self.get_logger().info(
+            f'{cfg.physics.robot_variant} car, time_step {cfg.physics.time_step} s, control '
+            f'period {cfg.control_period} s, '
+            + ('lockstep' if cfg.lockstep else f'real_time_factor {cfg.real_time_factor}')
+            + (', paused' if self._paused else ''))
+
+    def destroy_node(self) -> None:
+        self.sim.close()
+        super().destroy_node()
+
+    # --- stepping --------------------------------------------------------------------------
+
+    def _stamp(self):
+        return sim_time_msg(self.sim.steps, self._time_step_ns)
+
+    def _advance(self) -> None:
+        """One control period of physics, then publish the new state."""
+        self._command_ready = False
+        self.sim.step(self.config.steps_per_period)
+        self._periods += 1
+        self._period_start_wall = time.monotonic()
+        self._publish_state()
+
+    def _advance_if_running(self) -> None:
+        if not self._paused:
+            self._advance()
+
+    def _on_fast_timer(self) -> None:
+        deadline = time.monotonic() + FAST_BATCH_WALL_TIME
+        while not self._paused and time.monotonic() < deadline:
+            self._advance()
+
+    def _on_lockstep_timer(self) -> None:
+        if self._paused:
+            return
+        now = time.monotonic()
+        timeout = self.config.lockstep_timeout
+        if timeout > 0.0 and now - self._period_start_wall > timeout:
+            self.get_logger().warn(
+                f'lockstep: no actuator_command for {timeout} s, advancing without one',
+                throttle_duration_sec=5.0)
+            self._advance()
+        elif now - self._last_publish_wall > LOCKSTEP_REPUBLISH_PERIOD:
+            self._publish_state()
+
+    def _publish_state(self) -> None:
+        imu = self._periods % self.config.imu_every == 0
+        odometry = self._periods % self.config.ground_truth_every == 0
+        messages = self._messages
+        messages.fill(self.sim.state(), self._stamp(), imu, odometry)
+        self._clock_pub.publish(messages.clock)
+        self._joint_pub.publish(messages.joint_state)
+        if imu:
+            self._imu_pub.publish(messages.imu)
+        if odometry:
+            self._odom_pub.publish(messages.odometry)
+        self._last_publish_wall = time.monotonic()
+
+    # --- callbacks -------------------------------------------------------------------------
+
+    def _on_command(self, msg: ActuatorCommand) -> None:
+        try:
+            self.sim.set_command(msg.swivel_torque, msg.drive_speed)
+        except ValueError as error:
+            self.get_logger().warn(f'ignoring actuator_command: {error}',
+                                   throttle_duration_sec=1.0)
+            return
+        if not self.config.lockstep or msg.header.stamp != self._stamp():
+            return
+        if self._paused:
+            self._command_ready = True
+        else:
+            self._advance()
+
+    def _on_set_paused(self, request: SetBool.Request, response: SetBool.Response):
+        self._paused = request.data
+        self._period_start_wall = time.monotonic()  # the lockstep timeout restarts
+        response.success = True
+        response.message = 'paused' if self._paused else 'running'
+        if not self._paused and self._command_ready:
+            self._advance()
+        return response
+
+    def _on_step(self, request: StepSimulation.Request, response: StepSimulation.Response):
+        if not 1 <= request.steps <= MAX_STEPS_PER_CALL:
+            response.success = False
+            response.message = f'steps must be in [1, {MAX_STEPS_PER_CALL}], got {request.steps}'
+        elif not (self._paused or self.config.lockstep):
+            response.success = False
+            response.message = 'the sim is free running: pause it (~/set_paused) or use lockstep'
+        else:
+            remaining = request.steps
+            per_period = self.config.steps_per_period
+            while remaining > 0:
+                chunk = min(remaining, per_period - self.sim.steps % per_period)
+                self.sim.step(chunk)
+                remaining -= chunk
+                if self.sim.steps % per_period == 0:
+                    self._periods += 1
+                    self._publish_state()
+            self._command_ready = False
+            response.success = True
+            response.message = f'stepped {request.steps} steps'
+        response.sim_time = self._stamp()
+        return response
+
+    def _on_reset(self, request: ResetSimulation.Request, response: ResetSimulation.Response):
+        try:
+            self.sim.reset(request.x, request.y, request.yaw, request.remove_obstacles)
+        except ValueError as error:
+            response.success = False
+            response.message = f'reset refused: {error}'
+            return response
+        response.success = True
+        response.message = f'robot at ({request.x}, {request.y}, {request.yaw})'
+        self._period_start_wall = time.monotonic()
+        self._publish_state()
+        return response
+
+    def _on_spawn(self, request: SpawnObstacle.Request, response: SpawnObstacle.Response):
+        o = request.obstacle
+        try:
+            response.name = self.sim.spawn_obstacle(StepSpec(
+                o.name, o.height, o.depth, o.width, o.distance, o.yaw, o.friction))
+        except ValueError as error:
+            response.success = False
+            response.message = f'spawn refused: {error}'
+            return response
+        response.success = True
+        response.message = f'spawned {response.name}'
+        return response
+
+    def _on_remove(self, request: RemoveObstacle.Request, response: RemoveObstacle.Response):
+        try:
+            self.sim.remove_obstacle(request.name)
+        except ValueError as error:
+            response.success = False
+            response.message = f'remove refused: {error}'
+            return response
+        response.success = True
+        response.message = f'removed {request.name or "all obstacles"}'
+        return response
+
+
+def main(args=None) -> None:
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = SimNode()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except ValueError as error:
+        rclpy.logging.get_logger('sim').fatal(str(error))
+        raise SystemExit(1) from None
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,54 @@
+import math
+
+import pytest
+
+from swivel_car_sim.config import PARAMETERS, SimNodeConfig
+
+
+def test_defaults_give_the_architecture_timing():
+    cfg = SimNodeConfig.from_values({})
+    assert cfg.physics.time_step == 0.002
+    assert cfg.control_period == 0.01
+    assert cfg.steps_per_period == 5
+    assert cfg.imu_every == cfg.ground_truth_every == 1
+    assert not cfg.lockstep
+    assert cfg.physics.params.l == PARAMETERS['l'][0]
+
+
+def test_rates_and_geometry_overrides():
+    cfg = SimNodeConfig.from_values({'ground_truth_rate': 20.0, 'imu_rate': 50.0,
+                                     'phi': -0.5, 'mass': 10, 'time_step': 0.001})
+    assert cfg.ground_truth_every == 5 and cfg.imu_every == 2
+    assert cfg.steps_per_period == 10
+    assert cfg.physics.params.phi == -0.5 and cfg.physics.params.mass == 10.0
+
+
+@pytest.mark.parametrize('values, message', [
+    ({'control_period': 0.005 + 0.001}, 'control_period'),
+    ({'control_period': 0.001}, 'control_period'),
+    ({'imu_rate': 0.0}, 'imu_rate'),
+    ({'ground_truth_rate': 70.0}, 'ground_truth_rate'),
+    ({'lockstep_timeout': -1.0}, 'lockstep_timeout'),
+    ({'real_time_factor': math.inf}, 'real_time_factor'),
+    ({'lockstep': 1}, 'lockstep'),
+    ({'gui': 'yes'}, 'gui'),
+    ({'r': -0.075}, 'r must be > 0'),
+    ({'phi': 2.0}, 'phi'),
+    ({'robot_variant': 3}, 'robot_variant'),
+    ({'wheel_friction': 0.0}, 'wheel_friction')])
+def test_bad_values_are_refused_naming_the_parameter(values, message):
+    with pytest.raises(ValueError, match=message):
+        SimNodeConfig.from_values(values)
+
+
+def test_installed_yaml_states_every_parameter_with_its_default():
+    from pathlib import Path
+
+    import yaml
+    path = Path(__file__).resolve().parents[1] / 'config' / 'sim_node.yaml'
+    values = yaml.safe_load(path.read_text())['/**']['sim']['ros__parameters']
+    assert set(values) == set(PARAMETERS)
+    for name, value in values.items():
+        assert value == pytest.approx(PARAMETERS[name][0]) if isinstance(value, float) \
+            else value == PARAMETERS[name][0], name
+    SimNodeConfig.from_values(values)

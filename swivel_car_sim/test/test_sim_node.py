@@ -1,0 +1,245 @@
+"""The sim node's ROS surface, in process with real rclpy: lockstep, services, bad requests."""
+
+import math
+import os
+
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Imu, JointState
+from nav_msgs.msg import Odometry
+from std_srvs.srv import SetBool
+from swivel_car_msgs.msg import ActuatorCommand, StepObstacle
+from swivel_car_msgs.srv import RemoveObstacle, ResetSimulation, SpawnObstacle, StepSimulation
+from swivel_car_testing import next_domain_id, spin_until
+
+from swivel_car_sim.sim_node import SimNode
+
+TIMEOUT = 20.0  # [s] wall guard against a hang, not a measurement
+
+
+def _ns(stamp) -> int:
+    return stamp.sec * 1_000_000_000 + stamp.nanosec
+
+
+class Harness:
+    """A SimNode and a client node on one executor, in a fresh ROS domain and a namespace
+    of their own (other test runs on this machine may share the domain)."""
+
+    count = 0
+
+    def __init__(self, **parameters) -> None:
+        os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+        Harness.count += 1
+        namespace = f'/sim_node_test_{os.getpid()}_{Harness.count}'
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context, domain_id=next_domain_id())
+        self.sim = SimNode(context=self.context, namespace=namespace, parameter_overrides=[
+            Parameter(name, value=value) for name, value in parameters.items()])
+        self.client = Node('test_client', namespace=namespace, context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.sim)
+        self.executor.add_node(self.client)
+        self.joint_states, self.clock, self.imu, self.odom = [], [], [], []
+        self.client.create_subscription(JointState, 'joint_states', self.joint_states.append, 50)
+        self.client.create_subscription(Clock, '/clock', self.clock.append, 50)
+        self.client.create_subscription(Imu, 'imu', self.imu.append, 50)
+        self.client.create_subscription(Odometry, 'ground_truth/odom', self.odom.append, 50)
+        self.commands = self.client.create_publisher(ActuatorCommand, 'actuator_command', 10)
+
+    def call(self, kind, name: str, request):
+        client = self.client.create_client(kind, f'sim/{name}')
+        spin_until(self.executor, client.service_is_ready, TIMEOUT, f'service {name}')
+        future = client.call_async(request)
+        spin_until(self.executor, future.done, TIMEOUT, f'{name} response')
+        return future.result()
+
+    def command(self, stamp, swivel_torque: float = 0.0, drive_speed: float = 0.0) -> None:
+        msg = ActuatorCommand(swivel_torque=swivel_torque, drive_speed=drive_speed)
+        msg.header.stamp = stamp
+        self.commands.publish(msg)
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.sim.destroy_node()
+        self.client.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+
+
+@pytest.fixture
+def harness_factory():
+    made = []
+
+    def make(**parameters):
+        made.append(Harness(**parameters))
+        return made[-1]
+    yield make
+    for h in made:
+        h.close()
+
+
+def test_lockstep_advances_one_period_per_matching_command(harness_factory):
+    h = harness_factory(lockstep=True, lockstep_timeout=0.0)
+    spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
+    answered = set()
+    while len(answered) < 50:
+        latest = h.joint_states[-1]
+        if _ns(latest.header.stamp) not in answered:
+            answered.add(_ns(latest.header.stamp))
+            h.command(latest.header.stamp, drive_speed=5.0)
+        count = len(h.joint_states)
+        spin_until(h.executor, lambda: len(h.joint_states) > count, TIMEOUT, 'next state')
+    stamps = sorted({_ns(m.header.stamp) for m in h.joint_states})
+    assert stamps == [i * 10_000_000 for i in range(len(stamps))]
+    assert stamps[-1] == 50 * 10_000_000
+    assert h.sim.sim.steps == 50 * 5
+    assert h.joint_states[-1].name == ['swivel_joint', 'rear_left_wheel_joint',
+                                       'rear_right_wheel_joint', 'front_left_wheel_joint',
+                                       'front_right_wheel_joint']
+    assert h.joint_states[-1].velocity[1] > 1.0  # the commanded drive acts
+    spin_until(h.executor, lambda: h.odom and _ns(h.odom[-1].header.stamp) == stamps[-1],
+               TIMEOUT, 'ground truth')
+    assert h.odom[-1].header.frame_id == 'world'
+    assert h.odom[-1].child_frame_id == 'base_link'
+    assert h.odom[-1].twist.twist.linear.x > 0.05
+    assert stamps[-1] in {_ns(m.clock) for m in h.clock}  # /clock is global: others may add
+    assert h.imu[-1].linear_acceleration.z == pytest.approx(9.81, abs=0.3)
+    assert h.imu[-1].header.frame_id == 'base_link'
+    assert h.imu[-1].orientation.w == pytest.approx(1.0, abs=1e-3)
+
+
+def test_lockstep_ignores_stale_stamps_and_non_finite_commands(harness_factory):
+    h = harness_factory(lockstep=True, lockstep_timeout=0.0)
+    spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
+    stale = h.joint_states[-1].header.stamp
+    h.command(stale)
+    spin_until(h.executor, lambda: h.sim.sim.steps == 5, TIMEOUT, 'one period')
+    h.command(stale)  # the stamp of a state already answered
+    h.command(h.sim._stamp(), math.nan)
+    for _ in range(20):
+        h.executor.spin_once(timeout_sec=0.01)
+    assert h.sim.sim.steps == 5
+
+
+def _lockstep_run(h: Harness, periods: int) -> JointState:
+    """Answer each new state with a command that depends on it, as a controller would."""
+    spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
+    answered = set()
+    while h.sim.sim.steps < periods * 5:
+        latest = h.joint_states[-1]
+        if _ns(latest.header.stamp) not in answered:
+            answered.add(_ns(latest.header.stamp))
+            h.command(latest.header.stamp, swivel_torque=20.0 * (0.4 - latest.position[0]),
+                      drive_speed=4.0)
+        h.executor.spin_once(timeout_sec=0.05)
+    spin_until(h.executor, lambda: _ns(h.joint_states[-1].header.stamp) == periods * 10**7,
+               TIMEOUT, 'last state')
+    return h.joint_states[-1]
+
+
+def test_lockstep_results_do_not_depend_on_timing(harness_factory):
+    first = _lockstep_run(harness_factory(lockstep=True, lockstep_timeout=0.0), 60)
+    second = _lockstep_run(harness_factory(lockstep=True, lockstep_timeout=0.0), 60)
+    assert first.position[0] > 0.03  # the swivel moved
+    assert list(first.position) == list(second.position)
+    assert list(first.velocity) == list(second.velocity)
+
+
+def test_real_time_free_running_advances_and_applies_commands(harness_factory):
+    h = harness_factory(real_time_factor=4.0)
+    spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
+    h.command(h.joint_states[-1].header.stamp, drive_speed=5.0)
+    spin_until(h.executor, lambda: h.sim.sim.time > 0.2, TIMEOUT, 'free running')
+    assert h.joint_states[-1].velocity[1] > 1.0
+
+
+def test_step_service_advances_lockstep_without_a_controller(harness_factory):
+    h = harness_factory(lockstep=True, lockstep_timeout=0.0)
+    response = h.call(StepSimulation, 'step', StepSimulation.Request(steps=23))
+    assert response.success, response.message
+    assert _ns(response.sim_time) == 23 * 2_000_000
+    # states at the two crossed control periods, then (republished while waiting for a
+    # command) the state at the end of the step
+    wanted = {10_000_000, 20_000_000, 46_000_000}
+    spin_until(h.executor, lambda: {_ns(m.header.stamp) for m in h.joint_states} >= wanted,
+               TIMEOUT, 'states at the crossed control periods')
+
+
+def test_pause_stops_free_running_and_step_moves_it(harness_factory):
+    h = harness_factory(real_time_factor=0.0, start_paused=True)
+    for _ in range(20):
+        h.executor.spin_once(timeout_sec=0.01)
+    assert h.sim.sim.steps == 0
+    assert h.call(StepSimulation, 'step', StepSimulation.Request(steps=7)).success
+    assert h.sim.sim.steps == 7
+    assert h.call(SetBool, 'set_paused', SetBool.Request(data=False)).success
+    spin_until(h.executor, lambda: h.sim.sim.steps > 1000, TIMEOUT, 'free running')
+    refused = h.call(StepSimulation, 'step', StepSimulation.Request(steps=7))
+    assert not refused.success and 'pause' in refused.message
+
+
+@pytest.mark.parametrize('change, message', [
+    (dict(height=math.nan), 'height must be finite'), (dict(height=-0.1), 'height'),
+    (dict(distance=0.0, height=0.05), 'overlap'), (dict(yaw=2.0), 'yaw')])
+def test_bad_spawn_is_refused_with_a_message_and_changes_nothing(harness_factory, change,
+                                                                   message):
+    h = harness_factory(lockstep=True, lockstep_timeout=0.0)
+    fields = dict(name='', height=0.05, depth=0.5, width=1.0, distance=0.3, yaw=0.0,
+                  friction=1.0)
+    fields.update(change)
+    response = h.call(SpawnObstacle, 'spawn_obstacle',
+                      SpawnObstacle.Request(obstacle=StepObstacle(**fields)))
+    assert not response.success
+    assert message in response.message
+    assert h.sim.sim.obstacle_names == ()
+
+
+def test_spawn_remove_and_reset_services(harness_factory):
+    h = harness_factory(lockstep=True, lockstep_timeout=0.0)
+    spawn = h.call(SpawnObstacle, 'spawn_obstacle', SpawnObstacle.Request(
+        obstacle=StepObstacle(name='kerb', height=0.05, depth=0.5, width=1.0, distance=0.3,
+                              yaw=0.2, friction=1.0)))
+    assert spawn.success and spawn.name == 'kerb'
+    duplicate = h.call(SpawnObstacle, 'spawn_obstacle', SpawnObstacle.Request(
+        obstacle=StepObstacle(name='kerb', height=0.05, depth=0.5, width=1.0, distance=0.3,
+                              yaw=0.0, friction=1.0)))
+    assert not duplicate.success and 'exists' in duplicate.message
+    bad_reset = h.call(ResetSimulation, 'reset', ResetSimulation.Request(x=math.inf))
+    assert not bad_reset.success and 'finite' in bad_reset.message
+    reset = h.call(ResetSimulation, 'reset', ResetSimulation.Request(x=-1.0, y=0.5, yaw=0.3))
+    assert reset.success
+    assert h.sim.sim.state().position[0] == pytest.approx(-1.0)
+    assert h.sim.sim.obstacle_names == ('kerb',)
+    missing = h.call(RemoveObstacle, 'remove_obstacle', RemoveObstacle.Request(name='wall'))
+    assert not missing.success and 'no obstacle' in missing.message
+    assert h.call(RemoveObstacle, 'remove_obstacle', RemoveObstacle.Request(name='')).success
+    assert h.sim.sim.obstacle_names == ()
+
+
+def test_lockstep_timeout_advances_and_the_watchdog_stops_the_drive(harness_factory):
+    # No controller answers: the sim advances every lockstep_timeout (wall) and a single
+    # command acts until the watchdog (sim time) expires.
+    h = harness_factory(lockstep=True, lockstep_timeout=0.1, watchdog_timeout=0.05)
+    spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
+    h.command(h.joint_states[-1].header.stamp, swivel_torque=3.0, drive_speed=5.0)
+    spin_until(h.executor, lambda: h.sim.sim.time > 0.12, TIMEOUT, 'periods on timeout')
+    assert any(m.effort[0] == 3.0 for m in h.joint_states)
+    assert h.sim.sim.watchdog_tripped
+    assert h.joint_states[-1].effort[0] == 0.0
+
+
+@pytest.mark.parametrize('name, value, message', [
+    ('time_step', -0.001, 'time_step'), ('control_period', 0.003, 'control_period'),
+    ('real_time_factor', -1.0, 'real_time_factor'), ('robot_variant', 'tank', 'robot_variant'),
+    ('h', math.nan, 'h'), ('imu_rate', 30.0, 'imu_rate')])
+def test_bad_parameters_are_refused_at_start(name, value, message):
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=next_domain_id())
+    try:
+        with pytest.raises(ValueError, match=message):
+            SimNode(context=context, parameter_overrides=[Parameter(name, value=value)])
+    finally:
+        rclpy.try_shutdown(context=context)

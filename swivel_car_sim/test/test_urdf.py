@@ -1,0 +1,81 @@
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pybullet
+import pytest
+from swivel_car_model.params import SwivelCarParams
+
+from swivel_car_sim.urdf import build_robot, default_urdf_path, ROBOT_VARIANTS, WHEEL_JOINTS
+
+URDF_DIR = Path(__file__).resolve().parents[1] / 'urdf'
+
+DESIGNS = [SwivelCarParams(), SwivelCarParams(phi=-math.pi / 3),
+           SwivelCarParams(l=0.4, h=0.1, r=0.05), SwivelCarParams(h=0.25, r=0.1, phi=0.3)]
+
+
+@pytest.mark.parametrize('variant', ROBOT_VARIANTS)
+def test_committed_default_urdf_matches_generator(variant):
+    assert (URDF_DIR / default_urdf_path(variant)).read_text() == \
+        build_robot(SwivelCarParams(), variant).urdf, \
+        'regenerate: python -m swivel_car_sim.urdf --out swivel_car_sim/urdf'
+
+
+@pytest.mark.parametrize('variant', ROBOT_VARIANTS)
+def test_table2_mass_and_inertia(variant):
+    robot = build_robot(SwivelCarParams(), variant)
+    masses = [float(m.get('value')) for m in ET.fromstring(robot.urdf).iter('mass')]
+    assert sum(masses) == pytest.approx(21.0, rel=1e-9)
+    assert robot.mass == pytest.approx(21.0, rel=1e-9)
+    assert robot.inertia_about_rear_axle == pytest.approx(0.84, rel=1e-6)
+
+
+def test_inertia_out_of_reach_is_clamped_and_reported():
+    # A long car cannot reach 0.84 kg m^2: its front axle alone carries more.
+    robot = build_robot(SwivelCarParams(l=0.4, h=0.1, r=0.05))
+    assert robot.mass == pytest.approx(21.0)
+    assert robot.inertia_about_rear_axle > 0.84 * 1.5
+
+
+@pytest.mark.parametrize('params', DESIGNS)
+@pytest.mark.parametrize('variant', ROBOT_VARIANTS)
+def test_designs_load_in_pybullet_with_the_contract_joints(params, variant, tmp_path):
+    robot = build_robot(params, variant)
+    path = tmp_path / 'robot.urdf'
+    path.write_text(robot.urdf)
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        body = pybullet.loadURDF(str(path), physicsClientId=client)
+        info = [pybullet.getJointInfo(body, i, physicsClientId=client)
+                for i in range(pybullet.getNumJoints(body, physicsClientId=client))]
+    finally:
+        pybullet.disconnect(client)
+    joints = {i[1].decode(): i for i in info}
+    assert set(joints) == {robot.steer_joint, *WHEEL_JOINTS}
+    steer = joints[robot.steer_joint]
+    assert steer[2] == pybullet.JOINT_REVOLUTE
+    expected_axis = params.swivel_axis if variant == 'swivel' else [0.0, 0.0, 1.0]
+    np.testing.assert_allclose(steer[13], expected_axis, atol=1e-9)
+    if variant == 'swivel':
+        assert (steer[8], steer[9]) == pytest.approx(
+            (-params.max_swivel_angle, params.max_swivel_angle))
+    for name in WHEEL_JOINTS:
+        assert joints[name][2] == pybullet.JOINT_REVOLUTE
+        np.testing.assert_allclose(joints[name][13], [0.0, 1.0, 0.0], atol=1e-9)
+
+
+def test_wheels_sit_where_the_params_say():
+    p = SwivelCarParams(phi=-0.8, l=0.3, h=0.12)
+    root = ET.fromstring(build_robot(p).urdf)
+    origins = {j.get('name'): np.array(j.find('origin').get('xyz').split(), dtype=float)
+               for j in root.iter('joint')}
+    np.testing.assert_allclose(origins['swivel_joint'], p.apex, atol=1e-8)
+    np.testing.assert_allclose(origins['rear_left_wheel_joint'], [0, p.h, 0], atol=1e-8)
+    np.testing.assert_allclose(origins['front_right_wheel_joint'] + p.apex,
+                               p.front_axle + [0, -p.h, 0], atol=1e-8)
+
+
+def test_unknown_variant_is_refused():
+    with pytest.raises(ValueError, match='robot_variant'):
+        build_robot(SwivelCarParams(), 'tank')
