@@ -7,7 +7,7 @@ STAMP := $(VENV)/.requirements-installed
 IN_WS := scripts/in_ws
 PYTEST_ARGS ?=
 
-.PHONY: setup build test test-unit demo figures bench clean
+.PHONY: setup build test demo figures bench clean
 
 setup: $(STAMP)
 
@@ -33,8 +33,13 @@ demo: build
 figures: build
 	$(IN_WS) python -m swivel_car_model.figures --out docs/figures
 
+# Benchmarks print figures (speed as real-time factors and ratios, accuracy as errors);
+# no test ever times anything. The planner's climbs take several minutes.
 bench: build
-	$(IN_WS) python scripts/bench.py
+	$(IN_WS) python -m swivel_car_model.benchmark
+	$(IN_WS) python -m swivel_car_sim.benchmark
+	$(IN_WS) python -m swivel_car_control.benchmark
+	$(IN_WS) python -m swivel_car_planner.benchmark $(PLANNER_BENCH_ARGS)
 
 clean:
 	rm -rf ros2_ws/build ros2_ws/install ros2_ws/log

@@ -42,7 +42,9 @@ NODES = (('swivel_car_sim', 'sim_node'), ('swivel_car_control', 'controller_node
 
 # Lockstep: the physics advances only when the controller has answered, so the demo's outcome
 # does not depend on how busy the machine is.
-NODE_PARAMETERS = {'sim_node': {'lockstep': True, 'lockstep_timeout': 0.5, 'gui': False}}
+# Paced at twice real time, so that the demo's own node (outside the lockstep) keeps up.
+NODE_PARAMETERS = {'sim_node': {'lockstep': True, 'lockstep_timeout': 0.5,
+                                'lockstep_real_time_factor': 2.0, 'gui': False}}
 
 
 @dataclass
@@ -102,26 +104,33 @@ class DemoNode(Node):
 
     def drive(self, speed: float) -> None:
         msg = TwistStamped()
-        msg.header.stamp = self.get_clock().now().to_msg()
+        # A zero stamp: the controller stamps the command on receipt, so a moment's lag of
+        # the demo (it records four topics at 100 Hz) cannot make it look stale.
         msg.header.frame_id = 'base_link'
         msg.twist.linear.x = speed
         self.cmd_vel.publish(msg)
 
 
 class Progress:
-    """One progress line: rewritten in place on a terminal, a line per change otherwise."""
+    """One progress line: rewritten in place on a terminal; otherwise a line whenever the
+    phase changes and every few seconds."""
+
+    PERIOD = 3.0  # [s] wall, between lines when not on a terminal
 
     def __init__(self) -> None:
         self._tty = sys.stdout.isatty()
-        self._last = ''
+        self._phase = ''
+        self._printed = 0.0
 
-    def show(self, text: str) -> None:
+    def show(self, phase: str, text: str) -> None:
+        line = f'[{phase:>10}] {text}'
         if self._tty:
-            sys.stdout.write('\r' + text.ljust(100)[:100])
+            sys.stdout.write('\r' + line.ljust(100)[:100])
             sys.stdout.flush()
-        elif text.split(' t=')[0] != self._last.split(' t=')[0]:
-            print(text, flush=True)
-        self._last = text
+        elif phase != self._phase or time.monotonic() - self._printed > self.PERIOD:
+            print(line, flush=True)
+            self._printed = time.monotonic()
+        self._phase = phase
 
     def done(self) -> None:
         if self._tty:
@@ -169,7 +178,7 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
                     raise DemoError(f'{process.name} exited:\n{process.output()[-3000:]}')
             return False
 
-        progress.show('starting the stack: sim, controller, odometry, planner')
+        progress.show('start', 'the stack: sim, controller, odometry, planner')
         spin_until(executor, lambda: check_alive() or (
             node.spawn.service_is_ready() and node.climb.server_is_ready()
             and node.recording.odom), 90.0, 'the stack to come up')
@@ -190,8 +199,8 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
         while travelled() < drive_to:
             check_alive()
             node.drive(args.drive_speed)
-            progress.show(f'[drive ] towards the step: {args.step_distance - travelled():.2f} m '
-                          f'to go t={node.recording.odom[-1][0]:.1f} s')
+            progress.show('drive', f'towards the step: {args.step_distance - travelled():.2f} m '
+                                   f'to go, t = {node.recording.odom[-1][0]:.1f} s')
             spin_until(executor, lambda n=len(node.recording.odom): len(
                 node.recording.odom) > n + 4, 30.0, 'odometry while driving')
         stopped_at = len(node.recording.truth)
@@ -208,9 +217,9 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
                               plan_only=False, time_allowance=args.time_allowance)
         climb_start = node.recording.truth[-1][0]
         sent = node.climb.send_goal_async(goal, feedback_callback=lambda f: progress.show(
-            f'[{f.feedback.phase_name:>10}] {100 * f.feedback.progress:3.0f} %  swivel '
-            f'{f.feedback.swivel_angle:+.2f} rad  pitch {f.feedback.pitch:+.2f} rad  '
-            f'torque {f.feedback.swivel_torque:+5.1f} N m t={node.recording.truth[-1][0]:.1f} s'))
+            f.feedback.phase_name, f'{100 * f.feedback.progress:3.0f} %  swivel '
+            f'{f.feedback.swivel_angle:+.2f} rad  pitch {f.feedback.pitch:+.2f} rad  torque '
+            f'{f.feedback.swivel_torque:+5.1f} N m, t = {node.recording.truth[-1][0]:.1f} s'))
         spin_until(executor, lambda: check_alive() or sent.done(), 30.0, 'goal acceptance')
         if not sent.result().accepted:
             raise DemoError('the planner rejected the climb goal')
@@ -266,10 +275,10 @@ def summarise(args, recording: Recording, result, climb_start: float, climb_end:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--step-height', type=float, default=0.06, help='[m]')
-    parser.add_argument('--step-distance', type=float, default=1.2,
+    parser.add_argument('--step-height', type=float, default=0.04, help='[m]')
+    parser.add_argument('--step-distance', type=float, default=1.8,
                         help='[m] front axle ground contact to the step edge at the start')
-    parser.add_argument('--stop-before', type=float, default=0.5,
+    parser.add_argument('--stop-before', type=float, default=1.0,
                         help='[m] stop driving this far before the step, then climb')
     parser.add_argument('--drive-speed', type=float, default=0.3, help='[m/s]')
     parser.add_argument('--time-allowance', type=float, default=120.0, help='[s] sim time')

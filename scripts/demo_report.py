@@ -73,27 +73,36 @@ def plot_time_series(recording, summary: dict, out: Path) -> None:
     plt.close(fig)
 
 
-def render_frames(recording, summary: dict, step: StepSpec, out: Path) -> None:
+def render_frames(recording, summary: dict, step: StepSpec, folder: Path) -> None:
     """Replay the recorded ground truth and joint angles in a fresh pybullet world holding
-    the same robot and step, and render a strip of frames with pybullet's renderer."""
+    the same robot and step, and render with pybullet's renderer: a strip of frames of the
+    climb (frames.png) and, larger, the moment the swivel is turned furthest (car.png)."""
     truth = np.array(recording.truth)
     joint_times = np.array([t for t, _ in recording.joints])
+    swivel_index = recording.joint_names.index('swivel_joint')
     times = np.linspace(summary['climb_start'], summary['climb_end'], FRAME_COUNT)
     frames = []
     with SwivelCarSim(SimConfig()) as sim:
         sim.spawn_obstacle(step)
-        for t in times:
+
+        def show(t: float) -> np.ndarray:
             row = truth[np.argmin(np.abs(truth[:, 0] - t))]
             positions = recording.joints[int(np.argmin(np.abs(joint_times - t)))][1]
             sim.show_state(row[1:4], row[4:8], dict(zip(recording.joint_names, positions)))
-            frames.append(sim.render(width=320, height=240, target=row[1:4] + [0.2, 0, 0]))
+            return row[1:4] + [0.2, 0.0, 0.0]
+
+        for t in times:
+            frames.append(sim.render(width=320, height=240, target=show(t)))
+        swivel = [abs(positions[swivel_index]) for _, positions in recording.joints]
+        target = show(recording.joints[int(np.argmax(swivel))][0])
+        plt.imsave(folder / 'car.png', sim.render(width=800, height=450, target=target))
     fig, axes = plt.subplots(2, FRAME_COUNT // 2, figsize=(12, 4.6))
     for axis, image, t in zip(axes.flat, frames, times):
         axis.imshow(image)
         axis.set_title(f't = {t:.1f} s', fontsize=9)
         axis.axis('off')
     fig.tight_layout()
-    fig.savefig(out, dpi=100)
+    fig.savefig(folder / 'frames.png', dpi=100)
     plt.close(fig)
 
 
@@ -102,7 +111,7 @@ def write_report(summary: dict, recording, step: StepSpec, folder: Path) -> Path
     folder.mkdir(parents=True, exist_ok=True)
     plot_path(recording, step, folder / 'path.png')
     plot_time_series(recording, summary, folder / 'time_series.png')
-    render_frames(recording, summary, step, folder / 'frames.png')
+    render_frames(recording, summary, step, folder)
     rows = [
         ('climb', 'succeeded' if summary['success'] else f"failed: {summary['message']}"),
         ('step height', f"{summary['step_height'] * 100:.1f} cm"),
@@ -130,6 +139,10 @@ The stack ran as four processes (`sim_node`, `controller_node`, `odometry_node`,
 
 ## Frames of the climb (pybullet's renderer, replaying the ground truth)
 ![frames](frames.png)
+
+The swivel turned furthest:
+
+![the car](car.png)
 
 ## Path: odometry beside ground truth
 ![path](path.png)

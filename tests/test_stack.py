@@ -15,7 +15,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from swivel_car_model.params import SwivelCarParams
-from swivel_car_msgs.msg import StepObstacle
+from swivel_car_msgs.msg import StepObstacle, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, SpawnObstacle
 from swivel_car_testing import NodeProcess, config_path, spin_until
 
@@ -42,6 +42,9 @@ class Stack:
         self.clock: list[Clock] = []
         self.user.create_subscription(Odometry, 'ground_truth/odom', self.truth.append, 100)
         self.user.create_subscription(Clock, '/clock', self.clock.append, 100)
+        self.controller_states: list[SwivelControllerState] = []
+        self.user.create_subscription(SwivelControllerState, 'controller/controller_state',
+                                      self.controller_states.append, 100)
         self.cmd_vel = self.user.create_publisher(TwistStamped, 'cmd_vel', 10)
         self.spawn = self.user.create_client(SpawnObstacle, 'sim/spawn_obstacle')
         self.climb = self.user.create_client(ClimbStep, 'climb_step')
@@ -50,7 +53,9 @@ class Stack:
         package, executable = NODES[name]
         parameters = {'use_sim_time': True}
         if name == 'sim':
-            parameters.update(lockstep=True, lockstep_timeout=LOCKSTEP_TIMEOUT)
+            # Paced at real time so that this test's node, outside the lockstep, keeps up.
+            parameters.update(lockstep=True, lockstep_timeout=LOCKSTEP_TIMEOUT,
+                              lockstep_real_time_factor=1.0)
         return NodeProcess(package, executable, self.domain_id,
                            params_file=config_path(package, f'{executable}.yaml'),
                            parameters=parameters)
@@ -74,8 +79,9 @@ class Stack:
         """Publish cmd_vel at 20 Hz of sim time for ``duration`` sim seconds."""
         end = self.sim_time() + duration
         while self.sim_time() < end:
+            # A zero stamp: the controller stamps it on receipt, so a moment's lag of this
+            # node behind the sim cannot make the command look stale to the deadman.
             msg = TwistStamped()
-            msg.header.stamp = self.user.get_clock().now().to_msg()
             msg.twist.linear.x = speed
             self.cmd_vel.publish(msg)
             self.wait_sim_time(0.05, 'sim time while driving')
@@ -98,7 +104,8 @@ def stack(ros_domain) -> Iterator[Stack]:
     domain_id, context = ros_domain
     running = Stack(domain_id, context)
     try:
-        running.spin_until(lambda: running.truth and running.climb.service_is_ready()
+        running.spin_until(lambda: running.truth and running.controller_states
+                           and running.climb.service_is_ready()
                            and running.spawn.service_is_ready(), 90.0, 'the stack to start')
         yield running
     finally:
@@ -109,9 +116,13 @@ def test_drive_then_climb_a_step(stack: Stack):
     start = stack.x()
     stack.drive(0.3, 2.0)
     assert stack.x() - start > 0.4, 'cmd_vel did not move the car forward'
+    stack.drive(0.0, 1.0)
+    assert stack.speed() < 0.01, 'a zero cmd_vel did not stop the car'
 
     p = SwivelCarParams()
-    height, distance = 0.05, 0.3
+    # The planner needs room to turn to its approach heading; the rear axle climbs up to
+    # 4 cm by traction (see swivel_car_planner's README).
+    height, distance = 0.04, 1.0
     edge_x = stack.x() + p.wheelbase + distance
     spawned = stack.spawn.call_async(SpawnObstacle.Request(obstacle=StepObstacle(
         name='step', height=height, depth=1.5, width=1.6, distance=distance, yaw=0.0,
@@ -145,4 +156,6 @@ def test_killed_controller_stops_the_car_and_a_restart_recovers(stack: Stack):
     stack.processes['controller'] = stack.start('controller')
     x_before = stack.x()
     stack.drive(0.3, 5.0)
-    assert stack.x() > x_before + 0.5, 'the restarted controller did not drive the car'
+    assert stack.x() > x_before + 0.5, (
+        f"the restarted controller did not drive the car:\n"
+        f"{stack.processes['controller'].output()[-3000:]}")

@@ -4,13 +4,18 @@ Thesis II.E (eqs. 45-71) models the car seen from above as a tricycle whose sing
 wheel sits at an offset contact point that moves with the swivel angle. The printed equations
 are garbled, so this module derives the model again; corrections to the thesis:
 
-* eq. 60 mixes wheel *rates* and *speeds* (``theta_f_dot h2`` against ``r theta_r_dot h0``) and
-  eq. 62 prints ``b b`` for ``b b_dot``; eqs. 63/64 are not the solutions of eq. 60 (they carry
-  ``sin(phi_car)``, i.e. depend on the world heading, which no body-frame relation can).
-* eqs. 65-68 drop the steering wheel's constraint altogether: eq. 67/68 are the plain
-  unicycle relations, so the thesis' "offset" never reaches the pose; the generalized
-  coordinate count ("five" for a list of seven) is wrong too.
-* eq. 69-71 integrate with explicit Euler; we integrate exact arcs with the mean of the
+* the generalized coordinates are counted as "five" for a list of seven (x, y, theta_r,
+  theta_f, psi, a, b);
+* eq. 50 misplaces the parentheses: ``l2 = (-sin(phi_car + psi), cos(phi_car + psi))``;
+* eq. 60 mixes wheel *rates* and *speeds* (``theta_f_dot h2`` against ``r theta_r_dot h0``)
+  and eq. 62 prints ``b b`` for ``b b_dot``; eqs. 63/64 are not the solutions of eq. 60:
+  they carry ``sin(phi_car)``, i.e. depend on the world heading, which no body-frame
+  relation can, and name ``alpha_car`` what eq. 54 calls ``alpha_com``;
+* eq. 65, the rear wheels' no-skid constraint, has the wrong sign on ``x_dot``: it is
+  ``-x_dot sin(phi_car) + y_dot cos(phi_car) = 0`` (as eq. 66 writes it for the front);
+* eqs. 67/68 are the plain unicycle relations: the steering wheel's constraint and its offset
+  never reach the pose; we use that constraint for the yaw rate (below);
+* eqs. 69-71 integrate with explicit Euler; we integrate exact arcs with the mean of the
   twists at both ends of the step (second order).
 
 Derivation. ``base_link`` is the middle of the rear axle; it moves with speed ``v`` along its x
@@ -36,8 +41,8 @@ pitches about the rear axle by the lift angle ``theta1(theta2)`` as the swivel t
 rolling rate on the ground is the joint rate minus ``d theta1 / dt``.
 
 The contact point jumps from one front wheel to the other as theta2 crosses zero; that jump is
-no motion of any wheel, so ``(a_dot, b_dot)`` is always the derivative on the side of zero that
-``theta2`` lies on (its lateral part is zero at theta2 = 0).
+no motion of any wheel, so ``(a_dot, b_dot)`` is always the derivative for the wheel in contact
+(taken at |theta2| and mirrored with the car's symmetry).
 """
 
 from __future__ import annotations

@@ -197,3 +197,9 @@ def test_yaw_rate_from_the_rear_axle():
     assert omega == pytest.approx(P.r * 2.0 / (2.0 * P.h))
     with pytest.raises(ValueError):
         odometry.update(0.5, 0.0, 4.0, 0.01, rear_wheel_rate_difference=math.nan)
+
+
+def test_wheel_rate_for_speed():
+    assert planar.wheel_rate_for_speed(P, 0.3) == pytest.approx(0.3 / P.r)
+    with pytest.raises(ValueError):
+        planar.wheel_rate_for_speed(P, math.nan)

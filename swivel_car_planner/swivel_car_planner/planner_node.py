@@ -1,14 +1,14 @@
 """The planner node: climb_step as a service and as an action, one shared climb.
 
-A sim-time timer drives the core's ``ClimbStateMachine`` one control period at a time; the
-service and action callbacks run in a reentrant group on a multi-threaded executor and only
-wait on an event, so nothing blocks the executor.
+A sim-time timer drives the core's ``ClimbStateMachine`` one control period at a time. The
+service and action callbacks are coroutines that await the climb's future, so nothing blocks
+the executor: a single-threaded one serves everything. (Blocking callbacks on a
+MultiThreadedExecutor made its spin loop busy-wait at full CPU while a climb ran.)
 """
 
 from __future__ import annotations
 
 import math
-import threading
 from dataclasses import dataclass, fields
 
 from nav_msgs.msg import Odometry
@@ -16,8 +16,9 @@ import rclpy
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.action.server import ServerGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from rclpy.task import Future
 from rcl_interfaces.msg import ParameterDescriptor
 from sensor_msgs.msg import Imu, JointState
 from swivel_car_model import kinematics
@@ -47,7 +48,7 @@ class _ActiveClimb:
     """The one running climb, and who waits for it."""
 
     machine: ClimbStateMachine
-    done: threading.Event
+    done: Future
     goal_handle: ServerGoalHandle | None = None
 
 
@@ -91,7 +92,6 @@ class PlannerNode(Node):
             'swivel_joint', 'swivel_joint',
             ParameterDescriptor(description='name of the swivel joint in joint_states')).value
 
-        self._lock = threading.Lock()
         self._climb: _ActiveClimb | None = None
         self._received: dict[str, float] = {}  # topic -> sim time of its last message [s]
         self._odom: Odometry | None = None
@@ -105,6 +105,7 @@ class PlannerNode(Node):
         self.create_subscription(SwivelControllerState, 'controller/controller_state',
                                  self._on_controller_state, 10)
         self._command_pub = self.create_publisher(SwivelCommand, 'swivel_command', 10)
+        # Reentrant: a climb's coroutine holds its callback group while it awaits.
         requests = ReentrantCallbackGroup()
         self.create_service(ClimbStepService, 'climb_step', self._on_service,
                             callback_group=requests)
@@ -133,9 +134,8 @@ class PlannerNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _on_odom(self, msg: Odometry) -> None:
-        with self._lock:
-            self._odom = msg
-            self._received['odom'] = self._now()
+        self._odom = msg
+        self._received['odom'] = self._now()
 
     def _on_joint_states(self, msg: JointState) -> None:
         if self._swivel_joint not in msg.name:
@@ -144,46 +144,41 @@ class PlannerNode(Node):
         if index >= len(msg.position):
             return
         rate = msg.velocity[index] if index < len(msg.velocity) else 0.0
-        with self._lock:
-            self._swivel = (float(msg.position[index]), float(rate))
-            self._received['joint_states'] = self._now()
+        self._swivel = (float(msg.position[index]), float(rate))
+        self._received['joint_states'] = self._now()
 
     def _on_imu(self, msg: Imu) -> None:
         q = msg.orientation
-        with self._lock:
-            self._imu = (*roll_pitch(q.x, q.y, q.z, q.w), yaw_of(q.x, q.y, q.z, q.w))
-            self._received['imu'] = self._now()
+        self._imu = (*roll_pitch(q.x, q.y, q.z, q.w), yaw_of(q.x, q.y, q.z, q.w))
+        self._received['imu'] = self._now()
 
     def _on_controller_state(self, msg: SwivelControllerState) -> None:
-        with self._lock:
-            self._controller = msg
-            self._received['controller/controller_state'] = self._now()
+        self._controller = msg
+        self._received['controller/controller_state'] = self._now()
 
     def _missing_inputs(self) -> list[str]:
         """Inputs not heard within ``ready_timeout`` of sim time (all, before /clock)."""
         now = self._now()
         topics = ('joint_states', 'imu', 'odom', 'controller/controller_state')
-        with self._lock:
-            return [topic for topic in topics
-                    if now <= 0.0 or topic not in self._received
-                    or now - self._received[topic] > self._ready_timeout]
+        return [topic for topic in topics
+                if now <= 0.0 or topic not in self._received
+                or now - self._received[topic] > self._ready_timeout]
 
     def _observation(self) -> Observation:
-        with self._lock:
-            pose = self._odom.pose.pose
-            controller = self._controller
-            return Observation(
-                time=self._now(), x=pose.position.x, y=pose.position.y,
-                yaw=yaw_of(pose.orientation.x, pose.orientation.y, pose.orientation.z,
-                           pose.orientation.w),
-                swivel=self._swivel[0], swivel_rate=self._swivel[1],
-                set_point=controller.set_point, torque=controller.torque,
-                roll=self._imu[0], pitch=self._imu[1], imu_yaw=self._imu[2])
+        pose = self._odom.pose.pose
+        controller = self._controller
+        return Observation(
+            time=self._now(), x=pose.position.x, y=pose.position.y,
+            yaw=yaw_of(pose.orientation.x, pose.orientation.y, pose.orientation.z,
+                       pose.orientation.w),
+            swivel=self._swivel[0], swivel_rate=self._swivel[1],
+            set_point=controller.set_point, torque=controller.torque,
+            roll=self._imu[0], pitch=self._imu[1], imu_yaw=self._imu[2])
 
     # --- the climb ------------------------------------------------------------------------
 
-    def _run(self, request: ClimbRequest, goal_handle=None) -> _Result:
-        """Validate, plan and (unless plan_only) climb; blocks only the calling thread."""
+    async def _run(self, request: ClimbRequest, goal_handle=None) -> _Result:
+        """Validate, plan and (unless plan_only) climb; awaits the climb's end."""
         code, message = validate_request(request, self.config)
         if code != ErrorCode.NONE:
             return self._failure(code, message)
@@ -202,19 +197,15 @@ class PlannerNode(Node):
         climb = _ActiveClimb(
             ClimbStateMachine(self.robot, self.config, plan, request.step_distance,
                               request.step_yaw, request.time_allowance),
-            threading.Event(), goal_handle)
-        with self._lock:
-            if self._climb is not None:
-                return self._failure(ErrorCode.BUSY, 'a climb is already running')
-            self._climb = climb
+            Future(), goal_handle)
+        if self._climb is not None:
+            return self._failure(ErrorCode.BUSY, 'a climb is already running')
+        self._climb = climb
         self.get_logger().info(
             f'climbing a {request.step_height:.3f} m step {request.step_distance:.2f} m ahead: '
             f'swivel {plan.swivel_angle:.3f} rad, approach heading '
             f'{plan.approach_heading:.3f} rad')
-        while not climb.done.wait(0.1):
-            if not self.context.ok():
-                return self._failure(ErrorCode.CANCELED, 'the planner is shutting down')
-        outcome = climb.machine.outcome
+        outcome = await climb.done
         if outcome.success:
             self.get_logger().info(f'climb ended: {outcome.message}')
         else:
@@ -228,8 +219,7 @@ class PlannerNode(Node):
         return _Result(False, int(code), message, ClimbPlan(), ClimbOutcome())
 
     def _on_timer(self) -> None:
-        with self._lock:
-            climb = self._climb
+        climb = self._climb
         if climb is None:
             return
         if climb.goal_handle is not None and climb.goal_handle.is_cancel_requested:
@@ -239,9 +229,8 @@ class PlannerNode(Node):
         if climb.goal_handle is not None:
             climb.goal_handle.publish_feedback(self._feedback_msg(climb.machine.feedback))
         if climb.machine.outcome is not None:
-            with self._lock:
-                self._climb = None
-            climb.done.set()
+            self._climb = None
+            climb.done.set_result(climb.machine.outcome)
 
     def _publish_command(self, command: Command) -> None:
         msg = SwivelCommand()
@@ -264,12 +253,12 @@ class PlannerNode(Node):
 
     # --- service and action ---------------------------------------------------------------
 
-    def _on_service(self, request, response):
-        return self._run(request_from(request, with_time_allowance=False)).fill(response)
+    async def _on_service(self, request, response):
+        result = await self._run(request_from(request, with_time_allowance=False))
+        return result.fill(response)
 
     def _on_goal(self, goal) -> GoalResponse:
-        with self._lock:
-            busy = self._climb is not None
+        busy = self._climb is not None
         if busy and not goal.plan_only:
             self.get_logger().warning('climb_step goal rejected: a climb is already running')
             return GoalResponse.REJECT
@@ -278,9 +267,9 @@ class PlannerNode(Node):
     def _on_cancel(self, goal_handle) -> CancelResponse:
         return CancelResponse.ACCEPT
 
-    def _on_execute(self, goal_handle):
-        result = self._run(request_from(goal_handle.request, with_time_allowance=True),
-                           goal_handle)
+    async def _on_execute(self, goal_handle):
+        result = await self._run(
+            request_from(goal_handle.request, with_time_allowance=True), goal_handle)
         if result.success:
             goal_handle.succeed()
         elif result.error_code == ErrorCode.CANCELED and goal_handle.is_cancel_requested:
@@ -296,12 +285,10 @@ class PlannerNode(Node):
 
 def main(args=None) -> None:
     rclpy.init(args=args)
-    executor = MultiThreadedExecutor(num_threads=6)
     node = None
     try:
         node = PlannerNode()
-        executor.add_node(node)
-        executor.spin()
+        rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:

@@ -30,7 +30,7 @@ def refusal(p=P, config=CONFIG, **kwargs):
 
 
 def test_feasible_plan_clears_the_step_and_keeps_the_rules():
-    plan = make_plan(P, CONFIG, request(0.05))
+    plan = make_plan(P, FRONT, request(0.05))
     assert plan.procedure == PROCEDURE_ACTIVE_LIFT
     assert plan.wheel_clearance >= CONFIG.clearance_margin - 1e-9
     assert kinematics.lifted_wheel_lowest_height(P, plan.swivel_angle) == pytest.approx(
@@ -46,19 +46,19 @@ def test_feasible_plan_clears_the_step_and_keeps_the_rules():
 
 
 def test_swivel_angle_is_the_smallest_that_clears():
-    plan = make_plan(P, CONFIG, request(0.05))
+    plan = make_plan(P, FRONT, request(0.05))
     smaller = abs(plan.swivel_angle) - 0.01
     assert kinematics.lifted_wheel_lowest_height(P, smaller) < 0.05 + CONFIG.clearance_margin
 
 
 def test_square_step_lifts_the_left_wheel_and_turns_right_to_lead_with_it():
-    plan = make_plan(P, CONFIG, request(0.05, yaw=0.0))
+    plan = make_plan(P, FRONT, request(0.05, yaw=0.0))
     assert plan.lifted_side == 1 and plan.swivel_angle > 0.0
     assert plan.lead_angle < 0.0
 
 
 def test_step_yawed_the_other_way_lifts_the_right_wheel():
-    plan = make_plan(P, CONFIG, request(0.05, yaw=-0.3))
+    plan = make_plan(P, FRONT, request(0.05, yaw=-0.3))
     assert plan.lifted_side == -1 and plan.swivel_angle < 0.0
     assert plan.lead_angle > 0.0
 
@@ -71,7 +71,7 @@ def test_lead_angle_puts_the_lifted_wheel_over_before_the_other_meets_the_riser(
 
 
 def test_second_wheel_swivel_lifts_it_by_the_clearance_on_the_other_side():
-    plan = make_plan(P, CONFIG, request(0.05))
+    plan = make_plan(P, FRONT, request(0.05))
     assert plan.second_swivel_angle < 0.0 < plan.swivel_angle
     assert kinematics.lifted_wheel_lowest_height(P, plan.second_swivel_angle) == pytest.approx(
         CONFIG.clearance_margin)
@@ -123,10 +123,10 @@ def test_wheel_interference_refuses_a_long_shaft_on_a_short_body():
 
 
 def test_step_too_close_to_align_is_invalid_unless_plan_only():
-    error = refusal(height=0.05, distance=0.1)
+    error = refusal(config=FRONT, height=0.05, distance=0.1)
     assert error.code == ErrorCode.INVALID_REQUEST
     assert 'too close' in error.message
-    assert make_plan(P, CONFIG, request(0.05, distance=0.1, plan_only=True)).swivel_angle > 0.0
+    assert make_plan(P, FRONT, request(0.05, distance=0.1, plan_only=True)).swivel_angle > 0.0
 
 
 @settings(max_examples=30, deadline=None)

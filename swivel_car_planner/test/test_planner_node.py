@@ -18,7 +18,7 @@ import pytest
 import rclpy
 import yaml
 from rclpy.action import ActionClient
-from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
@@ -32,7 +32,7 @@ from swivel_car_planner.core import Command, ErrorCode, Phase, PlannerConfig
 from swivel_car_planner.kinematic_car import KinematicCar
 from swivel_car_planner.planner_node import PlannerNode
 
-SUCCESSFUL_CLIMB = dict(step_height=0.05, step_distance=1.2, step_yaw=0.0)
+SUCCESSFUL_CLIMB = dict(step_height=0.04, step_distance=1.2, step_yaw=0.0)
 
 
 def test_error_codes_and_phases_match_the_interfaces():
@@ -44,14 +44,14 @@ def test_error_codes_and_phases_match_the_interfaces():
 
 
 class Rig:
-    """Planner on a multi-threaded executor in a thread; the test's robot and clients."""
+    """Planner on its own executor in a thread; the test's robot and clients."""
 
     def __init__(self):
         os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=next_domain_id())
         self.planner = PlannerNode_with_sim_time(self.context)
-        self.planner_executor = MultiThreadedExecutor(num_threads=6, context=self.context)
+        self.planner_executor = SingleThreadedExecutor(context=self.context)
         self.planner_executor.add_node(self.planner)
         self.thread = threading.Thread(target=self.planner_executor.spin, daemon=True)
         self.thread.start()

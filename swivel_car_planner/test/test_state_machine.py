@@ -20,7 +20,7 @@ P = SwivelCarParams()
 CONFIG = PlannerConfig()
 
 
-def start(height=0.05, distance=1.2, yaw=0.0, config=CONFIG, allowance=0.0):
+def start(height=0.04, distance=1.2, yaw=0.0, config=CONFIG, allowance=0.0):
     request = ClimbRequest(height, distance, yaw, time_allowance=allowance)
     plan = make_plan(P, config, request)
     return ClimbStateMachine(P, config, plan, distance, yaw, allowance), plan
@@ -103,6 +103,18 @@ def test_rear_axle_that_does_not_climb_ends_failed_and_stopped():
     assert 'rear axle' in machine.outcome.message
 
 
+def test_front_coming_down_before_the_rear_reaches_the_edge_ends_failed():
+    machine, _ = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.step == Step.REAR)
+    car.extra_pitch = -0.1  # front on the step
+    car.apply(machine.update(car.observe()))
+    car.extra_pitch = 0.0  # level again, the rear wheels still well before the edge
+    car.apply(machine.update(car.observe()))
+    assert_safe_abort(machine, car, ErrorCode.FAILED)
+    assert 'came down' in machine.outcome.message
+
+
 def test_progress_never_goes_back():
     machine, _ = start()
     car = KinematicCar()
@@ -171,10 +183,21 @@ def test_nose_down_pitch_is_no_tip_over():
     assert machine.outcome is None
 
 
+def test_heading_comes_from_the_imu():
+    machine, plan = start(yaw=0.2)
+    car = KinematicCar()
+    car.extra_yaw = 0.3  # at the start: only an offset between the two headings
+    run(machine, car, until=lambda m, c: m.phase == Phase.LIFT)
+    car.odometry.set_pose(car.odometry.x, car.odometry.y, car.odometry.yaw + 0.2)
+    car.extra_yaw = 0.1  # odometry's heading jumped by 0.2 rad, the IMU's did not
+    run(machine, car)
+    assert machine.outcome.success, machine.outcome.message
+
+
 def test_heading_slip_between_imu_and_odometry_is_no_progress():
     machine, _ = start()
     car = KinematicCar()
-    run(machine, car, until=lambda m, c: m.phase == Phase.CLIMB_REST)
+    run(machine, car, until=lambda m, c: m.step == Step.REAR)
     car.extra_yaw = CONFIG.slip_yaw_tolerance + 0.01
     car.apply(machine.update(car.observe()))
     assert_safe_abort(machine, car, ErrorCode.NO_PROGRESS)

@@ -23,6 +23,9 @@ PARAMETERS: dict[str, tuple[object, str]] = {
                         'last joint_states stamp'),
     'lockstep_timeout': (1.0, '[s] wall time to wait for the command in lockstep before '
                               'advancing anyway; 0 = wait forever'),
+    'lockstep_real_time_factor': (0.0, '[1] in lockstep, at most this much sim time per wall '
+                                       'time, so that nodes outside the lockstep keep up; '
+                                       '0 = as fast as the controller answers'),
     'watchdog_timeout': (0.5, '[s] sim time without a command after which the swivel torque '
                               'is zeroed and the drive stops; 0 disables'),
     'robot_variant': ('swivel', "'swivel' or 'car_like' (baseline with a steered front axle)"),
@@ -60,6 +63,7 @@ class SimNodeConfig:
     real_time_factor: float  # [1]
     lockstep: bool
     lockstep_timeout: float  # [s]
+    lockstep_real_time_factor: float  # [1]
     initial_pose: tuple[float, float, float]  # [m], [m], [rad]
     start_paused: bool
     imu_every: int  # [1]
@@ -98,6 +102,9 @@ class SimNodeConfig:
                              'time_step')
         if v['real_time_factor'] < 0.0:
             raise ValueError(f'real_time_factor must be >= 0, got {v["real_time_factor"]!r}')
+        if v['lockstep_real_time_factor'] < 0.0:
+            raise ValueError('lockstep_real_time_factor must be >= 0, got '
+                             f'{v["lockstep_real_time_factor"]!r}')
         if v['lockstep_timeout'] < 0.0:
             raise ValueError(f'lockstep_timeout must be >= 0, got {v["lockstep_timeout"]!r}')
         every = {}
@@ -109,6 +116,7 @@ class SimNodeConfig:
         return cls(physics=physics, control_period=v['control_period'],
                    steps_per_period=steps, real_time_factor=v['real_time_factor'],
                    lockstep=v['lockstep'], lockstep_timeout=v['lockstep_timeout'],
+                   lockstep_real_time_factor=v['lockstep_real_time_factor'],
                    initial_pose=(v['initial_x'], v['initial_y'], v['initial_yaw']),
                    start_paused=v['start_paused'], imu_every=every['imu_rate'],
                    ground_truth_every=every['ground_truth_rate'])

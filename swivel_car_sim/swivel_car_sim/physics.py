@@ -428,6 +428,37 @@ class SwivelCarSim:
                                       else 0.0))
         return np.array(heights)
 
+    # --- replay and rendering --------------------------------------------------------------
+
+    def show_state(self, position: np.ndarray, orientation: np.ndarray,
+                   joint_positions: dict[str, float]) -> None:
+        """Place the robot at a recorded state without simulating: base_link at
+        ``position`` [m] with ``orientation`` (quaternion x, y, z, w), joints at
+        ``joint_positions`` [rad] (joints not named keep their angle)."""
+        com_pos, com_orn = pybullet.multiplyTransforms(
+            list(position), list(orientation), *self._com_in_link)
+        self._pb.resetBasePositionAndOrientation(self._body, com_pos, com_orn)
+        for name, joint in zip(self.joint_names, self._joint_ids):
+            if name in joint_positions:
+                self._pb.resetJointState(self._body, joint, float(joint_positions[name]))
+
+    def render(self, width: int = 320, height: int = 240,
+               target: np.ndarray | None = None, distance: float = 1.4,
+               yaw: float = -50.0, pitch: float = -25.0) -> np.ndarray:
+        """An RGB image (height x width x 3, uint8) from pybullet's software renderer, the
+        camera looking at ``target`` [m] (default base_link) from ``distance`` [m],
+        ``yaw`` and ``pitch`` [deg] as in pybullet's debug camera."""
+        if target is None:
+            target = self._base_pose()[0]
+        view = self._pb.computeViewMatrixFromYawPitchRoll(
+            cameraTargetPosition=list(map(float, target)), distance=distance, yaw=yaw,
+            pitch=pitch, roll=0.0, upAxisIndex=2)
+        projection = self._pb.computeProjectionMatrixFOV(
+            fov=50.0, aspect=width / height, nearVal=0.05, farVal=20.0)
+        _, _, rgba, _, _ = self._pb.getCameraImage(
+            width, height, view, projection, renderer=pybullet.ER_TINY_RENDERER)
+        return np.reshape(np.asarray(rgba, dtype=np.uint8), (height, width, 4))[:, :, :3]
+
     # --- obstacles -------------------------------------------------------------------------
 
     @property

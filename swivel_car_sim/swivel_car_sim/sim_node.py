@@ -63,8 +63,13 @@ class SimNode(Node):
         self.create_service(RemoveObstacle, '~/remove_obstacle', self._on_remove)
 
         wall = Clock(clock_type=ClockType.STEADY_TIME)
+        # Wall time a lockstep period must at least take (0: none).
+        self._lockstep_min_wall = (cfg.control_period / cfg.lockstep_real_time_factor
+                                   if cfg.lockstep_real_time_factor > 0.0 else 0.0)
         if cfg.lockstep:
             period = 0.02 if cfg.lockstep_timeout == 0.0 else min(0.02, cfg.lockstep_timeout / 4)
+            if self._lockstep_min_wall > 0.0:
+                period = min(period, self._lockstep_min_wall / 2.0)
             self.create_timer(period, self._on_lockstep_timer, clock=wall)
         elif cfg.real_time_factor > 0.0:
             self.create_timer(cfg.control_period / cfg.real_time_factor, self._advance_if_running,
@@ -104,8 +109,16 @@ class SimNode(Node):
         while not self._paused and time.monotonic() < deadline:
             self._advance()
 
+    def _advance_when_due(self) -> None:
+        """Lockstep: advance on the awaited command, but not faster than the pace cap."""
+        if time.monotonic() - self._period_start_wall >= self._lockstep_min_wall:
+            self._advance()
+
     def _on_lockstep_timer(self) -> None:
         if self._paused:
+            return
+        if self._command_ready:
+            self._advance_when_due()
             return
         now = time.monotonic()
         timeout = self.config.lockstep_timeout
@@ -141,10 +154,9 @@ class SimNode(Node):
             return
         if not self.config.lockstep or msg.header.stamp != self._stamp():
             return
-        if self._paused:
-            self._command_ready = True
-        else:
-            self._advance()
+        self._command_ready = True
+        if not self._paused:
+            self._advance_when_due()
 
     def _on_set_paused(self, request: SetBool.Request, response: SetBool.Response):
         self._paused = request.data

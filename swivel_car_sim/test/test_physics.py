@@ -356,3 +356,17 @@ def test_swivel_lift_puts_the_front_axle_on_a_step_that_blocks_driving_straight(
     assert blocked.pitch == pytest.approx(0.0, abs=0.01)
     assert climbed.pitch == pytest.approx(on_step_pitch, abs=0.01)
     np.testing.assert_allclose(lowest, [0.0, 0.0, height, height], atol=0.005)
+
+
+def test_show_state_places_the_robot_and_render_draws_it(sim):
+    position, orientation = np.array([0.3, -0.2, 0.09]), np.array(
+        pybullet.getQuaternionFromEuler([0.0, -0.1, 0.5]))
+    sim.show_state(position, orientation, {'swivel_joint': 0.4})
+    state = sim.state()
+    np.testing.assert_allclose(state.position, position, atol=1e-9)
+    np.testing.assert_allclose(np.abs(state.orientation @ orientation), 1.0, atol=1e-9)
+    assert math.isclose(state.positions[0], 0.4, abs_tol=1e-9)
+    image = sim.render(width=64, height=48)
+    assert image.shape == (48, 64, 3) and image.dtype == np.uint8
+    # The robot is in view: the picture is not one flat colour.
+    assert image.reshape(-1, 3).std(axis=0).max() > 10.0

@@ -2,6 +2,7 @@
 
 import math
 import os
+import time
 
 import pytest
 import rclpy
@@ -122,6 +123,21 @@ def test_lockstep_ignores_stale_stamps_and_non_finite_commands(harness_factory):
     for _ in range(20):
         h.executor.spin_once(timeout_sec=0.01)
     assert h.sim.sim.steps == 5
+
+
+def test_lockstep_pace_cap_holds_sim_time_below_wall_time(harness_factory):
+    # A lower bound only: the sim may never run ahead of the cap, however fast the answers.
+    h = harness_factory(lockstep=True, lockstep_timeout=0.0, lockstep_real_time_factor=2.0)
+    spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
+    start = time.monotonic()
+    answered = set()
+    while h.sim.sim.steps < 20 * 5:
+        latest = h.joint_states[-1]
+        if _ns(latest.header.stamp) not in answered:
+            answered.add(_ns(latest.header.stamp))
+            h.command(latest.header.stamp)
+        h.executor.spin_once(timeout_sec=0.001)
+    assert time.monotonic() - start >= 20 * 0.01 / 2.0 * 0.95
 
 
 def _lockstep_run(h: Harness, periods: int) -> JointState:

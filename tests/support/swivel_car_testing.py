@@ -17,7 +17,8 @@ from swivel_car_stack import (  # noqa: F401  (re-exported for the tests)
 
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
 # stragglers are never heard. The base spreads concurrent pytest processes apart.
-_DOMAIN_IDS = itertools.cycle(range(1 + (os.getpid() % 10) * 10, 1 + (os.getpid() % 10) * 10 + 10))
+_DOMAIN_BASE = 1 + (os.getpid() % 23) * 10  # ROS_DOMAIN_ID 1 .. 230
+_DOMAIN_IDS = itertools.cycle(range(_DOMAIN_BASE, _DOMAIN_BASE + 10))
 
 
 def next_domain_id() -> int:

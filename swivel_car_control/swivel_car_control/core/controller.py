@@ -238,9 +238,9 @@ class SwivelController:
                 source = SOURCE_CMD_VEL
                 if resolved.swivel is not None:  # None while both ramps still sit at zero
                     self._target = resolved.swivel
-                drive_target = resolved.v / self.p.r
-                if resolved.tightest:
-                    drive_target = self._tightest_turn_speed(resolved.omega, measured) / self.p.r
+                speed = (self._tightest_turn_speed(resolved.omega, measured)
+                         if resolved.tightest else resolved.v)
+                drive_target = planar.wheel_rate_for_speed(self.p, speed)
         set_point = self._set_point.step(self._target, dt, max_rate)
         pid = self.pid.step(set_point, measured, measured_rate, dt)
         scale = steering_speed_scale(self._target - measured, self.config.slowdown_start,

@@ -51,7 +51,7 @@ class PlannerConfig:
         0.25, 'odometry past the edge beyond rest_margin with the car still pitched: the '
         'rear axle failed to climb [m]')
     rear_step_limit: float = _field(
-        0.05, 'highest step the rear axle climbs by traction (measured in the sim); higher '
+        0.04, 'highest step the rear axle climbs by traction (measured in the sim); higher '
         'steps are refused as unreachable for the whole car [m]')
     rest_margin: float = _field(
         0.05, 'rear wheel contacts past the edge to call the climb done [m]')

@@ -26,12 +26,17 @@ way an operator would push the stick further.
 
 Monitors, every cycle: time allowance (TIMEOUT), nose-up pitch near the tip-over rule
 (TIP_OVER_ABORT), the swivel not closing on a wanted angle (STALL), no path length while
-driving (NO_PROGRESS), and the wheels slipping: the IMU's heading change parting from the
-odometry's by ``slip_yaw_tolerance`` (NO_PROGRESS too: the car does not go where odometry
-says; without this check a car whose front slid back off the step looked level and "past the
-edge" by odometry, a false success seen in the sim at 0.22 m). The rear axle failing to climb
-(odometry past the edge by ``rear_slip_allowance`` while the IMU still shows the car pitched)
-ends with FAILED. Any abort stops the drive and holds the swivel where it is.
+driving (NO_PROGRESS), and, while the rear axle climbs, the wheels slipping: the IMU's
+heading parting from the odometry's by ``slip_yaw_tolerance`` since the rear step began
+(NO_PROGRESS too: the car does not go where odometry says; without this check a car whose
+front slid back off the step looked level and "past the edge" by odometry, a false success
+seen in the sim at 0.22 m). The rear axle failing to climb (odometry past the edge by
+``rear_slip_allowance`` while the IMU still shows the car pitched) ends with FAILED, and so
+does the car coming level while the rear wheels are still short of the riser (the front came
+down). Any abort stops the drive and holds the swivel where it is.
+
+The heading always comes from the IMU, the position from odometry: the wheels skid when the
+swivel turns at a standstill, and odometry's heading then drifts (0.3 rad seen in the sim).
 """
 
 from __future__ import annotations
@@ -157,6 +162,8 @@ class ClimbStateMachine:
         self._last: Observation | None = None
         self._path = 0.0  # [m]
         self._yaw_offset = 0.0  # [rad] IMU heading minus odometry heading at the start
+        self._slip_ref = 0.0  # [rad] IMU minus odometry heading when the rear axle started
+        self._front_seen_up = False  # the IMU showed the car nose-up (front on the step)
         self._peak_torque = 0.0  # [N m]
         self._energy = 0.0  # [J]
         self._max_pitch = 0.0  # [rad]
@@ -211,7 +218,7 @@ class ClimbStateMachine:
         step = self._step
         if step == Step.APPROACH:
             if self._lifted_wheel_distance(obs) >= -plan.lead_distance:
-                error = plan.approach_heading - self._edge.relative_heading(obs.yaw)
+                error = plan.approach_heading - self._edge.relative_heading(self._heading(obs))
                 if abs(error) > config.align_tolerance:
                     return self._finish(
                         obs, ErrorCode.FAILED,
@@ -243,7 +250,17 @@ class ClimbStateMachine:
             return self._hold(obs, 0.0, 0.0)
         # REAR
         rear = self._rear_wheel_distance(obs)
-        if rear >= config.rest_margin and abs(obs.pitch) <= self._level:
+        level = abs(obs.pitch) <= self._level
+        if not level:
+            self._front_seen_up = True
+        if level and self._front_seen_up and rear < -self._p.r:
+            # Level again while the rear wheels are still short of the riser: the front
+            # came down off the step (it slid back or sideways), the rear did not climb.
+            return self._finish(
+                obs, ErrorCode.FAILED,
+                f'the front wheels came down off the step while the rear axle was still '
+                f'{-rear:.2f} m short of the edge')
+        if rear >= config.rest_margin and level:
             return self._finish(obs, ErrorCode.NONE,
                                 'climbed: all four wheels on top of the step')
         if rear >= config.rest_margin + config.rear_slip_allowance:
@@ -256,7 +273,7 @@ class ClimbStateMachine:
 
     def _steer(self, obs: Observation, heading: float, drive_speed: float) -> Command:
         """Drive at ``drive_speed`` steering towards ``heading`` (to the edge normal)."""
-        error = heading - self._edge.relative_heading(obs.yaw)
+        error = heading - self._edge.relative_heading(self._heading(obs))
         limit = self._config.max_steer
         steering = min(limit, max(-limit, self._config.heading_gain * error))
         self._bias = 0.0
@@ -309,6 +326,7 @@ class ClimbStateMachine:
             Step.SECOND_SET_DOWN: (obs.swivel, 0.0),
             Step.REAR: (self._rear_wheel_distance(obs), config.rest_margin)}
         self._span = spans.get(step, (0.0, 1.0))
+        self._slip_ref = wrap_angle(self._heading(obs) - obs.yaw)
         return self._advance(obs)
 
     # --- geometry -------------------------------------------------------------------------
@@ -319,7 +337,12 @@ class ClimbStateMachine:
         The rest geometry ignores how the swivel moves the front contacts (a few cm at the
         lift angles); ``lead_margin`` and ``lift_gap`` absorb it.
         """
-        return self._edge.signed_distance(*Pose2D(obs.x, obs.y, obs.yaw).transform(bx, by))
+        pose = Pose2D(obs.x, obs.y, self._heading(obs))
+        return self._edge.signed_distance(*pose.transform(bx, by))
+
+    def _heading(self, obs: Observation) -> float:
+        """The car's heading in the odometry frame, from the IMU (module docstring). # [rad]"""
+        return wrap_angle(obs.imu_yaw - self._yaw_offset)
 
     def _lifted_wheel_distance(self, obs: Observation) -> float:
         return self._wheel_distance(obs, self._p.wheelbase, self._plan.lifted_side * self._p.h)
@@ -385,8 +408,8 @@ class ClimbStateMachine:
             return (ErrorCode.STALL,
                     f'the swivel made no headway for {config.stall_time:.1f} s in {name} '
                     f'({error:.3f} rad off)')
-        slip = wrap_angle(obs.imu_yaw - obs.yaw - self._yaw_offset)
-        if abs(slip) > config.slip_yaw_tolerance:
+        slip = wrap_angle(self._heading(obs) - obs.yaw - self._slip_ref)
+        if self._step == Step.REAR and abs(slip) > config.slip_yaw_tolerance:
             return (ErrorCode.NO_PROGRESS,
                     f'the wheels slip: the IMU heading has turned {slip:+.2f} rad away from '
                     f'the odometry\'s in {name}')
