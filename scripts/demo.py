@@ -42,9 +42,10 @@ NODES = (('swivel_car_sim', 'sim_node'), ('swivel_car_control', 'controller_node
 
 # Lockstep: the physics advances only when the controller has answered, so the demo's outcome
 # does not depend on how busy the machine is.
-# Paced at twice real time, so that the demo's own node (outside the lockstep) keeps up.
+# Paced at real time, so that the planner and the demo's own node (both outside the lockstep
+# between sim and controller) keep up and act with a small, steady latency.
 NODE_PARAMETERS = {'sim_node': {'lockstep': True, 'lockstep_timeout': 0.5,
-                                'lockstep_real_time_factor': 2.0, 'gui': False}}
+                                'lockstep_real_time_factor': 1.0, 'gui': False}}
 
 
 @dataclass

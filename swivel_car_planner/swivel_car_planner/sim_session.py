@@ -81,8 +81,12 @@ class SimSession:
         joint = {'swivel_joint': 'steering_joint' if robot_variant == 'car_like'
                  else 'swivel_joint'}
         sim_time = {'use_sim_time': True, **joint}
+        # The planner acts on its own sim-time timer, outside the lockstep between sim and
+        # controller: pacing the sim at real time keeps its commands' latency small and
+        # steady, so climbs do not depend on how fast the machine answers.
         specs = [('swivel_car_sim', 'sim_node',
-                  {'lockstep': True, 'lockstep_timeout': 2.0, 'robot_variant': robot_variant}),
+                  {'lockstep': True, 'lockstep_timeout': 2.0, 'robot_variant': robot_variant,
+                   'lockstep_real_time_factor': 1.0}),
                  ('swivel_car_control', 'controller_node', sim_time),
                  ('swivel_car_control', 'odometry_node', sim_time)]
         if planner:
