@@ -165,7 +165,9 @@ class SimSession:
         if not response.success:
             raise RuntimeError(f'sim reset failed: {response.message}')
         self.call(self.odometry_reset, Empty.Request())
-        self.settle(0.5)
+        # The controller may still hold the last climb's swivel angle and turns the reset
+        # swivel back to it, which moves the car a little: let that end first.
+        self.settle(2.0)
 
     def settle(self, seconds: float) -> None:
         """Let ``seconds`` of wall time pass while spinning (the sim keeps stepping)."""
