@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 
 import pytest
-import rclpy
 from rclpy.action import ActionClient, ActionServer
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node

@@ -118,10 +118,11 @@ def approach_for_step(p: SwivelCarParams, step_height: float, gamma: float, thet
     kappa_positive = planar.curvature_for_swivel(p, magnitude)
     theta2 = magnitude if kappa_positive * turn > 0.0 else -magnitude
     kappa = planar.curvature_for_swivel(p, theta2)
-    x, y, yaw = 0.0, 0.0, theta_i
+    # Only x, along the step's normal, sets the distance to the edge.
+    x, yaw = 0.0, theta_i
     if include_drift:
         dx, dy, dyaw = dynamics.swivel_pose_drift(p, 0.0, theta2)
-        x, y = dx * math.cos(yaw) - dy * math.sin(yaw), dx * math.sin(yaw) + dy * math.cos(yaw)
+        x = dx * math.cos(yaw) - dy * math.sin(yaw)
         yaw += dyaw
     arc = gamma - yaw
     if arc * kappa <= 0.0:
@@ -129,7 +130,6 @@ def approach_for_step(p: SwivelCarParams, step_height: float, gamma: float, thet
             f'the swivel drift already turned past gamma (heading {yaw!r} rad after the swivel '
             f'move); approach with a larger |gamma - theta_i|')
     x_end = x + (math.sin(gamma) - math.sin(yaw)) / kappa
-    y_end = y - (math.cos(gamma) - math.cos(yaw)) / kappa
     lowest = lifted_wheel_lowest_point(p, theta2)
     distance = x_end + lowest[0] * math.cos(gamma) - lowest[1] * math.sin(gamma)
     radius = 1.0 / kappa
