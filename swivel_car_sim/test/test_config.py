@@ -29,6 +29,7 @@ def test_rates_and_geometry_overrides():
     ({'imu_rate': 0.0}, 'imu_rate'),
     ({'ground_truth_rate': 70.0}, 'ground_truth_rate'),
     ({'lockstep_timeout': -1.0}, 'lockstep_timeout'),
+    ({'lockstep_real_time_factor': -0.5}, 'lockstep_real_time_factor'),
     ({'real_time_factor': math.inf}, 'real_time_factor'),
     ({'lockstep': 1}, 'lockstep'),
     ({'gui': 'yes'}, 'gui'),
