@@ -13,7 +13,6 @@ succeeded.
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 import time
@@ -35,7 +34,7 @@ from swivel_car_msgs.srv import SpawnObstacle
 
 from demo_report import write_report
 from swivel_car_sim.physics import StepSpec
-from swivel_car_stack import REPO_ROOT, NodeProcess, config_path
+from swivel_car_stack import REPO_ROOT, spin_until, start_node
 
 NODES = (('swivel_car_sim', 'sim_node'), ('swivel_car_control', 'controller_node'),
          ('swivel_car_control', 'odometry_node'), ('swivel_car_planner', 'planner_node'))
@@ -63,11 +62,6 @@ class Recording:
 
 def stamp_seconds(stamp) -> float:
     return stamp.sec + 1e-9 * stamp.nanosec
-
-
-def pitch_of(qx: float, qy: float, qz: float, qw: float) -> float:
-    """REP-103 pitch (positive nose down). # [rad]"""
-    return math.asin(max(-1.0, min(1.0, 2.0 * (qw * qy - qz * qx))))
 
 
 class DemoNode(Node):
@@ -142,14 +136,6 @@ class DemoError(RuntimeError):
     """The demo could not do what it set out to do."""
 
 
-def spin_until(executor, condition, wall_timeout: float, what: str) -> None:
-    deadline = time.monotonic() + wall_timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            raise DemoError(f'timed out after {wall_timeout:.0f} s waiting for {what}')
-        executor.spin_once(timeout_sec=0.05)
-
-
 def demo_step(args: argparse.Namespace) -> StepSpec:
     """The step the demo spawns, square across the car's path."""
     return StepSpec(name='demo_step', height=args.step_height, depth=1.0, width=1.6,
@@ -161,10 +147,8 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
     was recorded."""
     domain_id = args.domain_id
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    processes = [NodeProcess(package, executable, domain_id,
-                             params_file=config_path(package, f'{executable}.yaml'),
-                             parameters={'use_sim_time': True,
-                                         **NODE_PARAMETERS.get(executable, {})})
+    processes = [start_node(package, executable, domain_id,
+                            {'use_sim_time': True, **NODE_PARAMETERS.get(executable, {})})
                  for package, executable in NODES]
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)
@@ -291,7 +275,7 @@ def main(argv: list[str] | None = None) -> int:
     progress = Progress()
     try:
         summary, recording = run_demo(args, progress)
-    except DemoError as error:
+    except (DemoError, TimeoutError) as error:
         progress.done()
         print(f'demo failed: {error}', file=sys.stderr)
         return 2

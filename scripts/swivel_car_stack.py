@@ -10,8 +10,9 @@ import os
 import signal
 import subprocess
 import tempfile
+import time
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import Any, Callable, Iterable, Mapping
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 INSTALL_DIR = Path(os.environ.get('SWIVEL_CAR_INSTALL', REPO_ROOT / 'ros2_ws' / 'install'))
@@ -105,3 +106,22 @@ def config_path(package: str, file_name: str) -> Path:
     if not path.is_file():
         raise FileNotFoundError(f'{path} does not exist: build the workspace (make build)')
     return path
+
+
+def start_node(package: str, executable: str, domain_id: int,
+               parameters: Mapping[str, Any]) -> NodeProcess:
+    """An installed node with its package's parameter file
+    (share/<package>/config/<executable>.yaml) and ``parameters`` on top."""
+    return NodeProcess(package, executable, domain_id, parameters,
+                       params_file=config_path(package, f'{executable}.yaml'))
+
+
+def spin_until(executor: Any, condition: Callable[[], bool], timeout: float,
+               what: str = 'condition') -> None:
+    """Spin ``executor`` until ``condition()`` holds; TimeoutError after ``timeout`` wall
+    seconds (a guard against a hang, not a measurement)."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise TimeoutError(f'timed out after {timeout} s waiting for {what}')
+        executor.spin_once(timeout_sec=0.05)

@@ -17,7 +17,7 @@ from rosgraph_msgs.msg import Clock
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_msgs.msg import StepObstacle, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, SpawnObstacle
-from swivel_car_testing import NodeProcess, config_path, spin_until
+from swivel_car_testing import NodeProcess, spin_until, start_node
 
 NODES = {'sim': ('swivel_car_sim', 'sim_node'),
          'controller': ('swivel_car_control', 'controller_node'),
@@ -56,9 +56,7 @@ class Stack:
             # Paced at real time so that this test's node, outside the lockstep, keeps up.
             parameters.update(lockstep=True, lockstep_timeout=LOCKSTEP_TIMEOUT,
                               lockstep_real_time_factor=1.0)
-        return NodeProcess(package, executable, self.domain_id,
-                           params_file=config_path(package, f'{executable}.yaml'),
-                           parameters=parameters)
+        return start_node(package, executable, self.domain_id, parameters)
 
     def spin_until(self, condition, timeout: float = 60.0, what: str = 'condition') -> None:
         def checked() -> bool:

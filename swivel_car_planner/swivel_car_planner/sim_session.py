@@ -32,7 +32,7 @@ except ImportError:  # outside pytest: the repository's helpers (pytest.ini puts
     _REPO = Path(__file__).resolve().parents[2]
     sys.path += [str(_REPO / 'scripts'), str(_REPO / 'tests' / 'support')]
     from swivel_car_testing import next_domain_id, spin_until
-from swivel_car_stack import config_path, NodeProcess
+from swivel_car_stack import NodeProcess, start_node
 
 CLIMB_WALL_LIMIT = 600.0  # [s] guard against a hung stack, not a measurement
 
@@ -95,9 +95,8 @@ class SimSession:
         self.processes: list[NodeProcess] = []
         try:
             for package, executable, parameters in specs:
-                self.processes.append(NodeProcess(
-                    package, executable, self.domain_id, parameters,
-                    params_file=config_path(package, f'{executable}.yaml')))
+                self.processes.append(start_node(package, executable, self.domain_id,
+                                                 parameters))
             os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
             self.context = rclpy.Context()
             rclpy.init(context=self.context, domain_id=self.domain_id)

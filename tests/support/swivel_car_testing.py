@@ -9,11 +9,10 @@ from __future__ import annotations
 
 import itertools
 import os
-import time
-from typing import Any, Callable
 
 from swivel_car_stack import (  # noqa: F401  (re-exported for the tests)
-    INSTALL_DIR, REPO_ROOT, NodeProcess, config_path, executable_path, ros_environment)
+    INSTALL_DIR, REPO_ROOT, NodeProcess, config_path, executable_path, ros_environment,
+    spin_until, start_node)
 
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
 # stragglers are never heard. The base spreads concurrent pytest processes apart.
@@ -25,13 +24,3 @@ def next_domain_id() -> int:
     """A ROS_DOMAIN_ID not used by the previous nine calls in this process."""
     return next(_DOMAIN_IDS)
 
-
-def spin_until(executor: Any, condition: Callable[[], bool], timeout: float,
-               what: str = 'condition') -> None:
-    """Spin ``executor`` until ``condition()`` holds; AssertionError after ``timeout``
-    wall seconds (a guard against a hang, not a measurement)."""
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            raise AssertionError(f'timed out after {timeout} s waiting for {what}')
-        executor.spin_once(timeout_sec=0.05)
