@@ -17,6 +17,7 @@ from rosgraph_msgs.msg import Clock
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_msgs.msg import StepObstacle, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, SpawnObstacle
+from swivel_car_planner.sim_session import GroundTruth
 from swivel_car_testing import NodeProcess, spin_until, start_node
 
 NODES = {'sim': ('swivel_car_sim', 'sim_node'),
@@ -133,10 +134,10 @@ def test_drive_then_climb_a_step(stack: Stack):
     stack.spin_until(response.done, 600.0, 'climb_step')
     result = response.result()
     assert result.success, f'{result.error_code}: {result.message}'
-    final = stack.truth[-1].pose.pose.position
-    # All four wheels on top: the rear axle is past the edge and a step higher.
-    assert final.x > edge_x + p.r
-    assert math.isclose(final.z, height + p.r, abs_tol=0.01)
+    final = GroundTruth.from_msg(stack.truth[-1])
+    assert final.four_wheels_on_top(height, p.r), final
+    # The rear wheels' contacts are past the edge whatever the car's heading (x forward).
+    assert final.x - p.h * abs(math.sin(final.yaw)) > edge_x, (final, edge_x)
 
 
 def test_killed_controller_stops_the_car_and_a_restart_recovers(stack: Stack):

@@ -49,15 +49,22 @@ class GroundTruth:
     yaw: float  # [rad]
     speed: float  # [m/s] |linear velocity|
 
+    @classmethod
+    def from_msg(cls, msg: Odometry) -> GroundTruth:
+        q = msg.pose.pose.orientation
+        roll = math.atan2(2.0 * (q.w * q.x + q.y * q.z), 1.0 - 2.0 * (q.x * q.x + q.y * q.y))
+        pitch = math.asin(max(-1.0, min(1.0, 2.0 * (q.w * q.y - q.z * q.x))))
+        yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+        v = msg.twist.twist.linear
+        p = msg.pose.pose.position
+        return cls(p.x, p.y, p.z, roll, pitch, yaw, math.sqrt(v.x ** 2 + v.y ** 2 + v.z ** 2))
 
-def _ground_truth(msg: Odometry) -> GroundTruth:
-    q = msg.pose.pose.orientation
-    roll = math.atan2(2.0 * (q.w * q.x + q.y * q.z), 1.0 - 2.0 * (q.x * q.x + q.y * q.y))
-    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (q.w * q.y - q.z * q.x))))
-    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-    v = msg.twist.twist.linear
-    p = msg.pose.pose.position
-    return GroundTruth(p.x, p.y, p.z, roll, pitch, yaw, math.sqrt(v.x ** 2 + v.y ** 2 + v.z ** 2))
+    def four_wheels_on_top(self, height: float, wheel_radius: float,
+                           tolerance: float = 0.01) -> bool:
+        """The rear axle (base_link) at step height and the car level: with the rear wheels
+        up, the front ones, a wheelbase ahead, are too."""
+        return (abs(self.z - (height + wheel_radius)) < tolerance
+                and abs(self.pitch) < 0.05 and abs(self.roll) < 0.05)
 
 
 class SimSession:
@@ -122,7 +129,7 @@ class SimSession:
         self._planner = planner
 
     def _on_truth(self, msg: Odometry) -> None:
-        self.truth = _ground_truth(msg)
+        self.truth = GroundTruth.from_msg(msg)
 
     def _on_odom(self, msg: Odometry) -> None:
         self.odom_count += 1
@@ -203,10 +210,8 @@ class SimSession:
         return front > height + self.wheel_radius - tolerance
 
     def four_wheels_on_top(self, height: float, tolerance: float = 0.01) -> bool:
-        """Ground truth: the rear axle (base_link) at step height and the car level."""
-        truth = self.truth
-        return (truth is not None and abs(truth.z - (height + self.wheel_radius)) < tolerance
-                and abs(truth.pitch) < 0.05 and abs(truth.roll) < 0.05)
+        return self.truth is not None and self.truth.four_wheels_on_top(
+            height, self.wheel_radius, tolerance)
 
     # The installed configs' geometry is thesis Table 2, SwivelCarParams' defaults.
     wheel_radius = SwivelCarParams().r  # [m]
