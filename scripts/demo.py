@@ -34,17 +34,20 @@ from swivel_car_msgs.srv import SpawnObstacle
 
 from demo_report import write_report
 from swivel_car_sim.physics import StepSpec
-from swivel_car_stack import REPO_ROOT, spin_until, start_node
+from swivel_car_stack import REPO_ROOT, lockstep_parameters, spin_until, start_node
 
 NODES = (('swivel_car_sim', 'sim_node'), ('swivel_car_control', 'controller_node'),
          ('swivel_car_control', 'odometry_node'), ('swivel_car_planner', 'planner_node'))
 
-# Lockstep: the physics advances only when the controller has answered, so the demo's outcome
-# does not depend on how busy the machine is.
-# Paced at real time, so that the planner and the demo's own node (both outside the lockstep
-# between sim and controller) keep up and act with a small, steady latency.
-NODE_PARAMETERS = {'sim_node': {'lockstep': True, 'lockstep_timeout': 0.5,
-                                'lockstep_real_time_factor': 1.0, 'gui': False}}
+# Lockstep: the physics advances only when the controller has answered, and the controller
+# takes the planner's commands in step, so the climb does not depend on how busy the machine
+# is. Paced at real time, so that the demo's own node (it drives by cmd_vel, outside the
+# lockstep) keeps up.
+LOCKSTEP_TIMEOUT = 0.5  # [s] wall
+NODE_PARAMETERS = {executable: {'use_sim_time': True,
+                                **lockstep_parameters(executable, LOCKSTEP_TIMEOUT)}
+                   for _, executable in NODES}
+NODE_PARAMETERS['sim_node']['gui'] = False
 
 
 @dataclass
@@ -147,8 +150,7 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
     was recorded."""
     domain_id = args.domain_id
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    processes = [start_node(package, executable, domain_id,
-                            {'use_sim_time': True, **NODE_PARAMETERS.get(executable, {})})
+    processes = [start_node(package, executable, domain_id, NODE_PARAMETERS[executable])
                  for package, executable in NODES]
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)

@@ -116,6 +116,21 @@ def start_node(package: str, executable: str, domain_id: int,
                        params_file=config_path(package, f'{executable}.yaml'))
 
 
+def lockstep_parameters(executable: str, lockstep_timeout: float,
+                        real_time_factor: float = 1.0) -> dict[str, Any]:
+    """Parameters that put ``executable`` into the lockstep chain of docs/architecture.md:
+    the sim waits for the controller's command of each state (at most ``lockstep_timeout``
+    wall seconds), the controller for the planner's command of the state before. The sim is
+    paced at ``real_time_factor`` (0: none) so that nodes outside the chain, publishing
+    cmd_vel, keep up."""
+    if executable == 'sim_node':
+        return {'lockstep': True, 'lockstep_timeout': lockstep_timeout,
+                'lockstep_real_time_factor': real_time_factor}
+    if executable == 'controller_node':
+        return {'lockstep_swivel_command': True, 'lockstep_wait': lockstep_timeout / 2.0}
+    return {}
+
+
 def spin_until(executor: Any, condition: Callable[[], bool], timeout: float,
                what: str = 'condition') -> None:
     """Spin ``executor`` until ``condition()`` holds; TimeoutError after ``timeout`` wall

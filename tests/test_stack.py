@@ -18,7 +18,7 @@ from swivel_car_model.params import SwivelCarParams
 from swivel_car_msgs.msg import StepObstacle, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, SpawnObstacle
 from swivel_car_planner.sim_session import GroundTruth
-from swivel_car_testing import NodeProcess, spin_until, start_node
+from swivel_car_testing import NodeProcess, lockstep_parameters, spin_until, start_node
 
 NODES = {'sim': ('swivel_car_sim', 'sim_node'),
          'controller': ('swivel_car_control', 'controller_node'),
@@ -52,12 +52,9 @@ class Stack:
 
     def start(self, name: str) -> NodeProcess:
         package, executable = NODES[name]
-        parameters = {'use_sim_time': True}
-        if name == 'sim':
-            # Paced at real time so that this test's node, outside the lockstep, keeps up.
-            parameters.update(lockstep=True, lockstep_timeout=LOCKSTEP_TIMEOUT,
-                              lockstep_real_time_factor=1.0)
-        return start_node(package, executable, self.domain_id, parameters)
+        # Paced at real time so that this test's node, outside the lockstep, keeps up.
+        return start_node(package, executable, self.domain_id, {
+            'use_sim_time': True, **lockstep_parameters(executable, LOCKSTEP_TIMEOUT)})
 
     def spin_until(self, condition, timeout: float = 60.0, what: str = 'condition') -> None:
         def checked() -> bool:
@@ -84,6 +81,19 @@ class Stack:
             msg.twist.linear.x = speed
             self.cmd_vel.publish(msg)
             self.wait_sim_time(0.05, 'sim time while driving')
+
+    def wait_planner_ready(self) -> None:
+        """Until the planner hears the whole stack: a plan-only request is answered, not
+        refused as NOT_READY."""
+        self.spin_until(self.climb.service_is_ready, 60.0, 'the climb_step service')
+        while True:
+            future = self.climb.call_async(ClimbStep.Request(
+                step_height=0.04, step_distance=1.0, step_yaw=0.0, plan_only=True))
+            self.spin_until(future.done, 30.0, 'a plan')
+            if future.result().error_code != ClimbStep.Response.ERROR_NOT_READY:
+                assert future.result().success, future.result().message
+                return
+            self.wait_sim_time(0.2, 'the planner to hear the stack')
 
     def x(self) -> float:
         return self.truth[-1].pose.pose.position.x
@@ -129,6 +139,7 @@ def test_drive_then_climb_a_step(stack: Stack):
     stack.spin_until(spawned.done, 30.0, 'spawn_obstacle')
     assert spawned.result().success, spawned.result().message
 
+    stack.wait_planner_ready()
     response = stack.climb.call_async(ClimbStep.Request(
         step_height=height, step_distance=distance, step_yaw=0.0, plan_only=False))
     stack.spin_until(response.done, 600.0, 'climb_step')
@@ -158,3 +169,23 @@ def test_killed_controller_stops_the_car_and_a_restart_recovers(stack: Stack):
     assert stack.x() > x_before + 0.5, (
         f"the restarted controller did not drive the car:\n"
         f"{stack.processes['controller'].output()[-3000:]}")
+
+
+def test_killed_planner_mid_climb_stops_the_car_and_a_restart_recovers(stack: Stack):
+    stack.wait_planner_ready()
+    climb = stack.climb.call_async(ClimbStep.Request(
+        step_height=0.04, step_distance=1.0, step_yaw=0.0, plan_only=False))
+    stack.spin_until(lambda: stack.speed() > 0.1 or climb.done(), 60.0, 'the climb to drive')
+    assert not climb.done(), climb.result().message
+    stack.processes['planner'].kill()
+    del stack.processes['planner']
+    # The controller's swivel_command deadman (0.5 s) stops the drive.
+    stack.wait_sim_time(1.5, 'the car to stop without a planner')
+    assert stack.speed() < 0.02
+    assert not climb.done()  # its server is gone; the client gives up on its own
+    states = stack.controller_states
+    assert states[-1].source == 'hold' and states[-1].drive_speed == 0.0
+
+    stack.spin_until(lambda: not stack.climb.service_is_ready(), 30.0, 'the planner to go')
+    stack.processes['planner'] = stack.start('planner')
+    stack.wait_planner_ready()

@@ -118,7 +118,8 @@ class ClosedLoop:
                  gains: dict[str, float] | None = None) -> None:
         base = p or SwivelCarParams()
         self.p = SwivelCarParams(**{**base.__dict__, **(gains or TUNED_GAINS)})
-        self.config = config or ControllerConfig(cmd_vel_timeout=0.0)
+        self.config = config or ControllerConfig(cmd_vel_timeout=0.0,
+                                                   swivel_command_timeout=0.0)
         self.sim = SwivelCarSim(SimConfig(params=self.p))
         self.steps_per_period = round(CONTROL_PERIOD / self.sim.config.time_step)
         self.controller = SwivelController(self.p, self.config)
@@ -161,9 +162,10 @@ class ClosedLoop:
         plan = segments + [Segment(settle, 'cmd_vel', 0.0, 0.0)]
         for segment in plan:
             if segment.kind == 'swivel':
-                self.controller.set_swivel_command(segment.a, 0.0, segment.b, True)
+                self.controller.set_swivel_command(segment.a, 0.0, segment.b, True,
+                                                   self.sim.time)
             else:
-                self.controller.set_swivel_command(0.0, 0.0, 0.0, False)
+                self.controller.set_swivel_command(0.0, 0.0, 0.0, False, self.sim.time)
             for _ in range(int(round(segment.duration / CONTROL_PERIOD))):
                 if segment.kind == 'cmd_vel':
                     self.controller.set_cmd_vel(segment.a, segment.b, self.sim.time)
@@ -171,7 +173,7 @@ class ClosedLoop:
                 distance += float(np.hypot(*(state.position[:2] - previous.position[:2])))
                 turned += abs(_wrap(state.yaw - previous.yaw))
                 previous = state
-        self.controller.set_swivel_command(0.0, 0.0, 0.0, False)
+        self.controller.set_swivel_command(0.0, 0.0, 0.0, False, self.sim.time)
         end = self.sim.state()
         x, y, yaw = end.position[0], end.position[1], end.yaw
 

@@ -4,10 +4,13 @@ joint_states message (the lockstep protocol of docs/architecture.md)."""
 from __future__ import annotations
 
 import dataclasses
+import math
 import sys
+import time
 
 from geometry_msgs.msg import Twist, TwistStamped
 from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
@@ -34,6 +37,8 @@ CONFIG_DESCRIPTIONS = {
     'max_angular_velocity': 'yaw rate limit [rad/s]',
     'max_angular_acceleration': 'yaw acceleration limit [rad/s^2]',
     'cmd_vel_timeout': 'deadman: older cmd_vel stops the drive, holds the swivel; 0 disables [s]',
+    'swivel_command_timeout': 'deadman: an older held swivel_command is released (drive stops, '
+                              'swivel holds, cmd_vel steers again); 0 disables [s]',
     'slowdown_start': 'swivel error below which the drive runs at full speed [rad]',
     'slowdown_stop': 'swivel error above which the drive stops; cos(error) between [rad]',
     'tip_over_margin': 'margin on thesis eq. 72, (pi - phi)/2 - theta1 >= margin [rad]',
@@ -53,14 +58,32 @@ class ControllerNode(Node):
         swivel_joint = self.declare_parameter(
             'swivel_joint', 'swivel_joint',
             ParameterDescriptor(description='name of the swivel joint in joint_states')).value
+        self._lockstep_swivel_command = self.declare_parameter(
+            'lockstep_swivel_command', False, ParameterDescriptor(
+                description='lockstep sim with a stamped swivel_command stream (the planner): '
+                            'answer each joint_states only once the command answering the '
+                            'previous one has come, so climbs do not depend on machine '
+                            'load')).value
+        self._lockstep_wait = self.declare_parameter(
+            'lockstep_wait', 0.05, ParameterDescriptor(
+                description='longest wall-time wait for that command; then answer without '
+                            'it and wait no more until the next command; keep it below the '
+                            "sim's lockstep_timeout [s]")).value
+        if not (math.isfinite(self._lockstep_wait) and self._lockstep_wait > 0.0):
+            raise ValueError(f'lockstep_wait must be > 0 s, got {self._lockstep_wait!r}')
         refuse_runtime_changes(self, {f.name for f in dataclasses.fields(car)}
                                | {f.name for f in dataclasses.fields(config)}
-                               | {'use_stamped', 'swivel_joint'})
+                               | {'use_stamped', 'swivel_joint', 'lockstep_swivel_command',
+                                  'lockstep_wait'})
         self._core = SwivelController(car, config)
         self._swivel_joint = swivel_joint
         self._joints = JointReader([swivel_joint])
-        self._warned_zero_stamp = False
-        self._last_time: float | None = None
+        self._warned_zero_stamp: set[str] = set()
+        self._last_time: float | None = None  # [s] stamp of the last joint_states answered
+        self._heard_command_time = -math.inf  # [s] stamp of the last stamped swivel_command
+        self._pending: JointState | None = None  # joint_states waiting for that command
+        self._pending_since = 0.0  # [s] wall
+        self._planner_late = False
 
         self._command_pub = self.create_publisher(ActuatorCommand, 'actuator_command', 10)
         self._state_pub = self.create_publisher(SwivelControllerState, '~/controller_state', 10)
@@ -69,54 +92,109 @@ class ControllerNode(Node):
         self.create_subscription(TwistStamped if self._use_stamped else Twist, 'cmd_vel',
                                  self._on_cmd_vel, 10)
         self.create_subscription(SwivelCommand, 'swivel_command', self._on_swivel_command, 10)
+        if self._lockstep_swivel_command:
+            self.create_timer(self._lockstep_wait / 4.0, self._on_wait_timer,
+                              clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.get_logger().info(
             f'controller up: swivel limit {self._core.swivel_limit:.3f} rad (tip-safe), '
             f'kp={car.kp} ki={car.ki} kd={car.kd}, cmd_vel as '
             f'{"TwistStamped" if self._use_stamped else "Twist"}, '
-            f'deadman {config.cmd_vel_timeout} s')
+            f'deadman {config.cmd_vel_timeout} s'
+            + (', lockstep with swivel_command' if self._lockstep_swivel_command else ''))
+
+    def _command_time(self, stamp, topic: str, timeout: float) -> float:
+        """A command's stamp in seconds of the node clock; a zero stamp or one from another
+        clock counts as now. # [s]"""
+        now = self.get_clock().now().nanoseconds * 1e-9
+        seconds = stamp_to_seconds(stamp)
+        if is_zero_stamp(stamp):
+            if topic not in self._warned_zero_stamp:
+                self.get_logger().warn(
+                    f'{topic} has a zero stamp: using the node clock (warned once)')
+                self._warned_zero_stamp.add(topic)
+            return now
+        if seconds > now + _CLOCK_SLACK:
+            # A stamp from another clock (wall time against sim time) would never expire.
+            self.get_logger().warn(
+                f'{topic} stamp is {seconds - now:.1f} s ahead of the node clock (clock '
+                'mismatch? use_sim_time?): using the node clock', throttle_duration_sec=5.0)
+            return now
+        if 0.0 < timeout < now - seconds:
+            self.get_logger().warn(
+                f'{topic} stamp is {now - seconds:.1f} s old, beyond its timeout: the deadman '
+                'ignores it (clock mismatch? use_sim_time?)', throttle_duration_sec=5.0)
+        return seconds
 
     def _on_cmd_vel(self, msg: TwistStamped | Twist) -> None:
-        now = self.get_clock().now().nanoseconds * 1e-9
         if isinstance(msg, TwistStamped):
             twist = msg.twist
-            stamp = stamp_to_seconds(msg.header.stamp)
-            if is_zero_stamp(msg.header.stamp):
-                if not self._warned_zero_stamp:
-                    self.get_logger().warn(
-                        'cmd_vel has a zero stamp: using the node clock (warned once)')
-                    self._warned_zero_stamp = True
-                stamp = now
-            elif stamp > now + _CLOCK_SLACK:
-                # A stamp from another clock (wall time against sim time) would never expire.
-                self.get_logger().warn(
-                    f'cmd_vel stamp is {stamp - now:.1f} s ahead of the node clock (clock '
-                    'mismatch? use_sim_time?): using the node clock',
-                    throttle_duration_sec=5.0)
-                stamp = now
-            elif 0.0 < self._core.config.cmd_vel_timeout < now - stamp:
-                self.get_logger().warn(
-                    f'cmd_vel stamp is {now - stamp:.1f} s old, beyond cmd_vel_timeout: the '
-                    'deadman ignores it (clock mismatch? use_sim_time?)',
-                    throttle_duration_sec=5.0)
+            stamp = self._command_time(msg.header.stamp, 'cmd_vel',
+                                       self._core.config.cmd_vel_timeout)
         else:
             twist = msg
-            stamp = now
+            stamp = self.get_clock().now().nanoseconds * 1e-9
         try:
             self._core.set_cmd_vel(twist.linear.x, twist.angular.z, stamp)
         except ValueError as error:
             self.get_logger().warn(str(error))
 
     def _on_swivel_command(self, msg: SwivelCommand) -> None:
+        held_before = self._core.swivel_command is not None
+        if not is_zero_stamp(msg.header.stamp):
+            # Even a refused command answers its cycle: the lockstep wait is over.
+            self._heard_command_time = stamp_to_seconds(msg.header.stamp)
+            self._planner_late = False
         try:
-            self._core.set_swivel_command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold)
+            self._core.set_swivel_command(
+                msg.angle, msg.max_rate, msg.drive_speed, msg.hold,
+                self._command_time(msg.header.stamp, 'swivel_command',
+                                   self._core.config.swivel_command_timeout))
         except ValueError as error:
-            self.get_logger().error(str(error))
-            return
-        self.get_logger().info(
-            f'swivel_command: angle {msg.angle:.3f} rad, drive {msg.drive_speed:.3f} rad/s'
-            if msg.hold else 'swivel_command released: cmd_vel steers again')
+            self.get_logger().error(str(error), throttle_duration_sec=1.0)
+        else:
+            if msg.hold and not held_before:
+                self.get_logger().info(
+                    f'swivel_command takes over: angle {msg.angle:.3f} rad, drive '
+                    f'{msg.drive_speed:.3f} rad/s')
+            elif held_before and not msg.hold:
+                self.get_logger().info('swivel_command released: cmd_vel steers again')
+        if self._pending is not None and not self._must_wait(self._pending):
+            self._answer(self._take_pending())
+
+    def _must_wait(self, msg: JointState) -> bool:
+        """Lockstep with a stamped swivel_command held: ``msg`` waits for the command that
+        answers the previous joint_states (the planner's pipeline is one cycle deep)."""
+        if (not self._lockstep_swivel_command or self._planner_late or self._last_time is None
+                or self._core.swivel_command is None):
+            return False
+        return (stamp_to_seconds(msg.header.stamp) > self._last_time
+                > self._heard_command_time)
+
+    def _take_pending(self) -> JointState:
+        msg, self._pending = self._pending, None
+        return msg
+
+    def _on_wait_timer(self) -> None:
+        if (self._pending is not None
+                and time.monotonic() - self._pending_since > self._lockstep_wait):
+            self.get_logger().warn(
+                f'no swivel_command answered the last state within lockstep_wait '
+                f'{self._lockstep_wait} s: going on without it until the next command comes '
+                '(the climb is no longer deterministic)', throttle_duration_sec=5.0)
+            self._planner_late = True
+            self._answer(self._take_pending())
 
     def _on_joint_states(self, msg: JointState) -> None:
+        if self._must_wait(msg):
+            if self._pending is None or self._pending.header.stamp != msg.header.stamp:
+                self._pending_since = time.monotonic()
+            self._pending = msg
+            return
+        self._pending = None
+        self._answer(msg)
+
+    def _answer(self, msg: JointState) -> None:
+        """One ActuatorCommand (and controller state) for this joint_states."""
         t = stamp_to_seconds(msg.header.stamp)
         command = ActuatorCommand()
         command.header.stamp = msg.header.stamp
@@ -136,6 +214,9 @@ class ControllerNode(Node):
         if out.cmd_vel_timed_out:
             self.get_logger().info('cmd_vel timed out: drive stopped, swivel held',
                                    throttle_duration_sec=10.0)
+        if out.swivel_command_timed_out:
+            self.get_logger().warn('swivel_command timed out (planner gone?): released, drive '
+                                   'stopped, swivel held')
         command.swivel_torque = out.swivel_torque
         command.drive_speed = out.drive_speed
         self._command_pub.publish(command)

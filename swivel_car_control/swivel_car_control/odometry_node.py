@@ -32,7 +32,7 @@ _LIMIT_SLACK = 0.05  # [rad]
 class OdometryConfig:
     """Frames, rates and covariances of the odometry node (see CONFIG_DESCRIPTIONS)."""
 
-    publish_rate: float = 50.0  # [Hz]
+    publish_rate: float = 100.0  # [Hz]
     odom_frame_id: str = 'odom'
     base_frame_id: str = 'base_link'
     tf_frame_prefix: str = ''
@@ -71,7 +71,8 @@ class OdometryConfig:
 
 
 CONFIG_DESCRIPTIONS = {
-    'publish_rate': 'rate of odom (and TF) messages [Hz]',
+    'publish_rate': 'rate of odom (and TF) messages, by joint_states time: at most one per '
+                    'joint_states, each stamped with it [Hz]',
     'odom_frame_id': 'fixed frame of the odometry (header.frame_id)',
     'base_frame_id': 'robot frame (child_frame_id)',
     'tf_frame_prefix': 'prefix for both frame ids, e.g. a robot name; empty = none',
@@ -106,7 +107,7 @@ class OdometryNode(Node):
         self._joints = JointReader([config.swivel_joint, config.rear_left_wheel_joint,
                                     config.rear_right_wheel_joint])
         self._last_time: float | None = None  # [s] of the last joint_states used
-        self._last_stamp = None
+        self._next_publish: float | None = None  # [s] joint_states time of the next odom
         self._tf = self._make_tf_broadcaster() if config.enable_odom_tf else None
 
         self._pose_covariance = _diagonal(config.pose_covariance_diagonal)
@@ -115,7 +116,6 @@ class OdometryNode(Node):
         self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
         self.create_service(Empty, '~/reset', self._on_reset)
         self.create_service(SetPose2D, '~/set_pose', self._on_set_pose)
-        self.create_timer(1.0 / config.publish_rate, self._publish)
 
     def _make_tf_broadcaster(self):
         try:
@@ -136,6 +136,7 @@ class OdometryNode(Node):
                                    'pose kept')
             self._joints.reset()
             self._last_time = None
+            self._next_publish = None
         try:
             joints = self._joints.read(t, msg.name, msg.position, msg.velocity)
         except MissingJointError as error:
@@ -156,15 +157,19 @@ class OdometryNode(Node):
             self.get_logger().warn(f'odometry not updated: {error}', throttle_duration_sec=5.0)
             return
         self._last_time = t
-        self._last_stamp = msg.header.stamp
+        # Published on joint_states time, not a timer: in a lockstep sim every run publishes
+        # the same poses, and a consumer can wait for the odom of a given state.
+        period = 1.0 / c.publish_rate
+        if self._next_publish is None or t >= self._next_publish - 1e-9:
+            due = (t if self._next_publish is None else self._next_publish) + period
+            self._next_publish = due if due > t else t + period
+            self._publish(msg.header.stamp)
 
-    def _publish(self) -> None:
-        if self._last_stamp is None:
-            return
+    def _publish(self, stamp) -> None:
         c = self._config
         odometry = self._odometry
         msg = Odometry()
-        msg.header.stamp = self._last_stamp
+        msg.header.stamp = stamp
         msg.header.frame_id = c.frame(c.odom_frame_id)
         msg.child_frame_id = c.frame(c.base_frame_id)
         msg.pose.pose.position.x = odometry.x

@@ -13,7 +13,8 @@ from swivel_car_control.core.controller import ControllerConfig
 
 @pytest.fixture
 def loop():
-    closed_loop = ClosedLoop(config=ControllerConfig(cmd_vel_timeout=0.5))
+    closed_loop = ClosedLoop(config=ControllerConfig(cmd_vel_timeout=0.5,
+                                                      swivel_command_timeout=0.0))
     yield closed_loop
     closed_loop.close()
 
@@ -82,9 +83,9 @@ def test_non_finite_command_keeps_the_last_safe_state(loop):
 
 @pytest.mark.parametrize('start, target', [(0.0, 0.5), (0.0, 1.2), (1.2, -1.2)])
 def test_swivel_step_response(loop, start, target):
-    loop.controller.set_swivel_command(start, 0.0, 0.0, True)
+    loop.controller.set_swivel_command(start, 0.0, 0.0, True, loop.sim.time)
     drive(loop, 2.0)
-    loop.controller.set_swivel_command(target, 0.0, 0.0, True)
+    loop.controller.set_swivel_command(target, 0.0, 0.0, True, loop.sim.time)
     t0 = loop.sim.time
     trace = []
     for _ in range(400):

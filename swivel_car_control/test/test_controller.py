@@ -105,28 +105,47 @@ def test_non_finite_cmd_vel_keeps_the_last_safe_command(bad, slot):
 
 
 def test_swivel_command_takes_over_and_releases():
-    controller = make(cmd_vel_timeout=0.0)
+    controller = make(cmd_vel_timeout=0.0, swivel_command_timeout=0.0)
     controller.set_cmd_vel(0.2, 0.0, 0.0)
     run(controller, 0.0, 0.5)
-    controller.set_swivel_command(0.6, 0.2, 1.0, True)
+    controller.set_swivel_command(0.6, 0.2, 1.0, True, 0.5)
     out = run(controller, 0.5, 1.0, measured=0.6)
     assert out.source == SOURCE_SWIVEL_COMMAND
     assert out.target == 0.6
     assert out.set_point == pytest.approx(0.2, abs=0.011)  # its own rate limit, 0.2 rad/s
     assert out.drive_speed == pytest.approx(1.0)
-    controller.set_swivel_command(0.0, 0.0, 0.0, False)
+    controller.set_swivel_command(0.0, 0.0, 0.0, False, 1.5)
     out = run(controller, 1.5, 1.0)
     assert out.source == SOURCE_CMD_VEL
     assert out.target == 0.0
 
 
+def test_stale_swivel_command_is_released_holding_the_swivel():
+    """The planner died: its last command (driving, swivel at 0.6) expires, the drive stops,
+    the swivel holds where the command left it, and cmd_vel steers again."""
+    controller = make(cmd_vel_timeout=0.0, swivel_command_timeout=0.5)
+    controller.set_swivel_command(0.6, 0.0, 2.0, True, 0.0)
+    out = run(controller, 0.0, 0.5)
+    assert out.source == SOURCE_SWIVEL_COMMAND and not out.swivel_command_timed_out
+    assert out.drive_speed > 0.0
+    out = controller.step(0.51, out.set_point, 0.0)
+    assert out.swivel_command_timed_out and controller.swivel_command is None
+    out = run(controller, 0.52, 1.5)
+    assert out.source == SOURCE_HOLD and not out.swivel_command_timed_out
+    assert out.target == 0.6 and out.drive_speed == 0.0
+    controller.set_cmd_vel(0.2, 0.0, 2.02)
+    assert run(controller, 2.02, 0.5).source == SOURCE_CMD_VEL
+
+
 def test_swivel_command_refusals_change_nothing():
     controller = make(swivel_limit=1.2)
-    controller.set_swivel_command(0.5, 0.0, 0.0, True)
+    controller.set_swivel_command(0.5, 0.0, 0.0, True, 0.0)
     for args, match in (((1.3, 0.0, 0.0), 'outside'), ((math.nan, 0.0, 0.0), 'angle'),
                         ((0.1, -1.0, 0.0), 'max_rate'), ((0.1, 0.0, math.inf), 'drive_speed')):
         with pytest.raises(ValueError, match=match):
-            controller.set_swivel_command(*args, True)
+            controller.set_swivel_command(*args, True, 0.0)
+    with pytest.raises(ValueError, match='stamp'):
+        controller.set_swivel_command(0.1, 0.0, 0.0, True, math.nan)
     assert controller.swivel_command.angle == 0.5
 
 
@@ -135,7 +154,7 @@ def test_swivel_command_breaking_the_tip_over_rule_is_refused():
     controller = make(tip_over_margin=margin)
     assert controller.swivel_limit < 1.4
     with pytest.raises(ValueError, match='tip-over'):
-        controller.set_swivel_command(1.0, 0.0, 0.0, True)
+        controller.set_swivel_command(1.0, 0.0, 0.0, True, 0.0)
     assert controller.swivel_command is None
 
 

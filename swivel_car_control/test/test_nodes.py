@@ -40,6 +40,7 @@ class Harness:
     def record(self, msg_type, topic):
         self.received[topic] = []
         self.probe.create_subscription(msg_type, topic, self.received[topic].append, 10)
+        return self.received[topic]
 
     def wait_connected(self, publisher):
         spin_until(self.executor, lambda: publisher.get_subscription_count() > 0, 10.0,
@@ -174,6 +175,69 @@ def test_swivel_command_and_refusal(controller):
     assert states[-1].target == 0.5
 
 
+def stamped_swivel_command(t, angle, hold=True):
+    msg = SwivelCommand(angle=angle, hold=hold)
+    msg.header.stamp = joint_state(t).header.stamp
+    return msg
+
+
+def test_lockstep_waits_for_the_planners_command_of_the_previous_state():
+    harness = Harness(ControllerNode, {'lockstep_swivel_command': True, 'lockstep_wait': 0.5})
+    try:
+        commands = harness.record(ActuatorCommand, 'actuator_command')
+        states = harness.record(SwivelControllerState, 'controller/controller_state')
+        harness.joints = harness.probe.create_publisher(JointState, 'joint_states', 10)
+        swivel = harness.probe.create_publisher(SwivelCommand, 'swivel_command', 10)
+        for publisher in (harness.joints, swivel):
+            harness.wait_connected(publisher)
+        spin_until(harness.executor, lambda: all(
+            harness.probe.count_publishers(topic) for topic in harness.received), 10.0,
+            'publishers')
+
+        def state_of(t, timeout=10.0):
+            stamp = joint_state(t).header.stamp
+            spin_until(harness.executor, lambda: states and states[-1].header.stamp == stamp,
+                       timeout, f'the state of {t}')
+            return states[-1]
+
+        step(harness, 1.0)  # nothing held: no wait
+        swivel.publish(stamped_swivel_command(1.0, 0.3))
+        for _ in range(20):  # the first command is taken whenever it comes
+            harness.executor.spin_once(timeout_sec=0.01)
+        step(harness, 1.01)
+        assert state_of(1.01).target == pytest.approx(0.3)
+
+        # The command answering 1.01 has not come: 1.02 waits for it, then takes it.
+        harness.joints.publish(joint_state(1.02))
+        for _ in range(20):
+            harness.executor.spin_once(timeout_sec=0.01)
+        assert commands[-1].header.stamp == joint_state(1.01).header.stamp
+        swivel.publish(stamped_swivel_command(1.01, 0.4))
+        assert state_of(1.02).target == pytest.approx(0.4)
+
+        # A planner that does not answer: after lockstep_wait the controller goes on, and
+        # waits no more until the next command.
+        harness.joints.publish(joint_state(1.03))
+        assert state_of(1.03, 5.0).target == pytest.approx(0.4)
+        step(harness, 1.04)
+
+        # The next command re-arms the wait; a release ends it.
+        swivel.publish(stamped_swivel_command(1.04, 0.5))
+        for _ in range(20):
+            harness.executor.spin_once(timeout_sec=0.01)
+        harness.joints.publish(joint_state(1.05))
+        assert state_of(1.05).target == pytest.approx(0.5)
+        harness.joints.publish(joint_state(1.06))
+        for _ in range(20):
+            harness.executor.spin_once(timeout_sec=0.01)
+        assert states[-1].header.stamp == joint_state(1.05).header.stamp
+        swivel.publish(stamped_swivel_command(1.05, 0.0, hold=False))
+        assert state_of(1.06).source == 'hold'
+        step(harness, 1.07)  # released: no wait
+    finally:
+        harness.close()
+
+
 def test_plain_twist_parameter():
     harness = Harness(ControllerNode, {'use_stamped': False, 'cmd_vel_timeout': 0.0})
     try:
@@ -262,3 +326,19 @@ def test_odometry_without_velocities_differences_wrapped_positions(odometry):
         'odom'][-1].header.stamp == msgs[-1].header.stamp, 10.0, 'odom')
     assert odometry.received['odom'][-1].pose.pose.position.x == pytest.approx(
         9.9 * 0.075, rel=1e-6)  # the first message has nothing to difference against
+
+
+def test_odometry_publishes_at_its_rate_by_joint_states_time():
+    harness = Harness(OdometryNode, {'publish_rate': 40.0})
+    try:
+        odom = harness.record(Odometry, 'odom')
+        harness.joints = harness.probe.create_publisher(JointState, 'joint_states', 10)
+        harness.wait_connected(harness.joints)
+        feed(harness, 1.0, 1.0, wheel_rate=1.0)
+        stamps = [round(m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec, 3) for m in odom]
+        # 40 Hz from 100 Hz states: every 2.5 states on average, each on a state's stamp.
+        assert stamps[0] == 1.0 and stamps[-1] == 2.0
+        assert len(stamps) == 41
+        assert all(0.02 <= b - a <= 0.03 + 1e-9 for a, b in zip(stamps, stamps[1:]))
+    finally:
+        harness.close()

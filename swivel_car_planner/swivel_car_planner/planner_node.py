@@ -1,9 +1,12 @@
 """The planner node: climb_step as a service and as an action, one shared climb.
 
-A sim-time timer drives the core's ``ClimbStateMachine`` one control period at a time. The
-service and action callbacks are coroutines that await the climb's future, so nothing blocks
-the executor: a single-threaded one serves everything. (Blocking callbacks on a
-MultiThreadedExecutor made its spin loop busy-wait at full CPU while a climb ran.)
+The core's ``ClimbStateMachine`` steps once per controller state, on the inputs of that
+moment (``core.sync``), and the command it answers carries that moment's stamp: in a lockstep
+sim the controller applies it exactly one cycle later (its ``lockstep_swivel_command``), so a
+climb does not depend on how busy the machine is. The service and action callbacks are
+coroutines that await the climb's future, so nothing blocks the executor: a single-threaded
+one serves everything. (Blocking callbacks on a MultiThreadedExecutor made its spin loop
+busy-wait at full CPU while a climb ran.)
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from dataclasses import dataclass, fields
 
 from nav_msgs.msg import Odometry
 import rclpy
+from rclpy.time import Time
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.action.server import ServerGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -32,6 +36,10 @@ from swivel_car_planner.conversions import (
 from swivel_car_planner.core import (
     ClimbRequest, ClimbStateMachine, Command, ErrorCode, Observation, PlanError,
     PlannerConfig, make_plan, validate_request)
+from swivel_car_planner.core.sync import InputSync, Tick
+
+_CONTROLLER_STATE = 'controller/controller_state'
+_INPUTS = ('joint_states', 'imu', 'odom', _CONTROLLER_STATE)
 
 _ROBOT_DESCRIPTIONS = {
     'l': 'length of each T column [m]', 'h': 'half-length of each wheel shaft [m]',
@@ -84,25 +92,22 @@ class PlannerNode(Node):
                 name, float(getattr(defaults, name)),
                 ParameterDescriptor(description=description)).value)
             for name, description in _ROBOT_DESCRIPTIONS.items()})
-        self._control_period = self._positive_parameter(
-            'control_period', 0.01, 'period of the climb state machine, sim time [s]')
         self._ready_timeout = self._positive_parameter(
-            'ready_timeout', 1.0, 'inputs older than this (sim time) mean not ready [s]')
+            'ready_timeout', 1.0, 'inputs older than this (sim time) mean not ready; a climb '
+                                  'whose inputs stop for this long aborts [s]')
         self._swivel_joint = self.declare_parameter(
             'swivel_joint', 'swivel_joint',
             ParameterDescriptor(description='name of the swivel joint in joint_states')).value
 
         self._climb: _ActiveClimb | None = None
         self._received: dict[str, float] = {}  # topic -> sim time of its last message [s]
-        self._odom: Odometry | None = None
-        self._swivel = (0.0, 0.0)  # (angle [rad], rate [rad/s])
-        self._imu = (0.0, 0.0, 0.0)  # (roll, pitch, yaw) [rad]
-        self._controller: SwivelControllerState | None = None
+        self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
+        self._last_tick = 0.0  # [s] sim time of the last tick of the running climb
 
         self.create_subscription(Odometry, 'odom', self._on_odom, 10)
         self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
         self.create_subscription(Imu, 'imu', self._on_imu, 10)
-        self.create_subscription(SwivelControllerState, 'controller/controller_state',
+        self.create_subscription(SwivelControllerState, _CONTROLLER_STATE,
                                  self._on_controller_state, 10)
         self._command_pub = self.create_publisher(SwivelCommand, 'swivel_command', 10)
         # Reentrant: a climb's coroutine holds its callback group while it awaits.
@@ -113,7 +118,7 @@ class PlannerNode(Node):
             self, ClimbStepAction, 'climb_step', execute_callback=self._on_execute,
             goal_callback=self._on_goal, cancel_callback=self._on_cancel,
             callback_group=requests)
-        self.create_timer(self._control_period, self._on_timer)
+        self.create_timer(self._ready_timeout / 4.0, self._check_inputs_alive)
         self.get_logger().info(
             f'planner ready: model max scalable step {self._max_step():.3f} m, torque limit '
             f'{self.config.torque_limit:.1f} N m')
@@ -134,8 +139,9 @@ class PlannerNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _on_odom(self, msg: Odometry) -> None:
-        self._odom = msg
-        self._received['odom'] = self._now()
+        q = msg.pose.pose.orientation
+        self._add('odom', msg, (msg.pose.pose.position.x, msg.pose.pose.position.y,
+                                yaw_of(q.x, q.y, q.z, q.w)))
 
     def _on_joint_states(self, msg: JointState) -> None:
         if self._swivel_joint not in msg.name:
@@ -144,36 +150,37 @@ class PlannerNode(Node):
         if index >= len(msg.position):
             return
         rate = msg.velocity[index] if index < len(msg.velocity) else 0.0
-        self._swivel = (float(msg.position[index]), float(rate))
-        self._received['joint_states'] = self._now()
+        self._add('joint_states', msg, (float(msg.position[index]), float(rate)))
 
     def _on_imu(self, msg: Imu) -> None:
         q = msg.orientation
-        self._imu = (*roll_pitch(q.x, q.y, q.z, q.w), yaw_of(q.x, q.y, q.z, q.w))
-        self._received['imu'] = self._now()
+        self._add('imu', msg, (*roll_pitch(q.x, q.y, q.z, q.w), yaw_of(q.x, q.y, q.z, q.w)))
 
     def _on_controller_state(self, msg: SwivelControllerState) -> None:
-        self._controller = msg
-        self._received['controller/controller_state'] = self._now()
+        self._add(_CONTROLLER_STATE, msg, (msg.set_point, msg.torque))
+
+    def _add(self, topic: str, msg, value: tuple) -> None:
+        self._received[topic] = self._now()
+        stamp = msg.header.stamp
+        for tick in self._sync.add(topic, stamp.sec + 1e-9 * stamp.nanosec, value):
+            self._on_tick(tick)
 
     def _missing_inputs(self) -> list[str]:
         """Inputs not heard within ``ready_timeout`` of sim time (all, before /clock)."""
         now = self._now()
-        topics = ('joint_states', 'imu', 'odom', 'controller/controller_state')
-        return [topic for topic in topics
+        return [topic for topic in _INPUTS
                 if now <= 0.0 or topic not in self._received
                 or now - self._received[topic] > self._ready_timeout]
 
-    def _observation(self) -> Observation:
-        pose = self._odom.pose.pose
-        controller = self._controller
+    @staticmethod
+    def _observation(tick: Tick) -> Observation:
+        x, y, yaw = tick.values['odom']
+        swivel, swivel_rate = tick.values['joint_states']
+        roll, pitch, imu_yaw = tick.values['imu']
+        set_point, torque = tick.values[_CONTROLLER_STATE]
         return Observation(
-            time=self._now(), x=pose.position.x, y=pose.position.y,
-            yaw=yaw_of(pose.orientation.x, pose.orientation.y, pose.orientation.z,
-                       pose.orientation.w),
-            swivel=self._swivel[0], swivel_rate=self._swivel[1],
-            set_point=controller.set_point, torque=controller.torque,
-            roll=self._imu[0], pitch=self._imu[1], imu_yaw=self._imu[2])
+            time=tick.time, x=x, y=y, yaw=yaw, swivel=swivel, swivel_rate=swivel_rate,
+            set_point=set_point, torque=torque, roll=roll, pitch=pitch, imu_yaw=imu_yaw)
 
     # --- the climb ------------------------------------------------------------------------
 
@@ -201,6 +208,7 @@ class PlannerNode(Node):
         if self._climb is not None:
             return self._failure(ErrorCode.BUSY, 'a climb is already running')
         self._climb = climb
+        self._last_tick = self._now()
         self.get_logger().info(
             f'climbing a {request.step_height:.3f} m step {request.step_distance:.2f} m ahead: '
             f'swivel {plan.swivel_angle:.3f} rad, approach heading '
@@ -218,23 +226,46 @@ class PlannerNode(Node):
         self.get_logger().warning(f'climb_step refused ({code.name}): {message}')
         return _Result(False, int(code), message, ClimbPlan(), ClimbOutcome())
 
-    def _on_timer(self) -> None:
+    def _on_tick(self, tick: Tick) -> None:
         climb = self._climb
         if climb is None:
             return
+        self._last_tick = tick.time
         if climb.goal_handle is not None and climb.goal_handle.is_cancel_requested:
             climb.machine.cancel()
-        command = climb.machine.update(self._observation())
-        self._publish_command(command)
+        command = climb.machine.update(self._observation(tick))
+        self._publish_command(command, tick.time)
         if climb.goal_handle is not None:
             climb.goal_handle.publish_feedback(self._feedback_msg(climb.machine.feedback))
         if climb.machine.outcome is not None:
-            self._climb = None
-            climb.done.set_result(climb.machine.outcome)
+            self._end(climb, tick.time)
 
-    def _publish_command(self, command: Command) -> None:
+    def _check_inputs_alive(self) -> None:
+        """A climb whose inputs stopped (odometry or controller gone) ends: the controller's
+        swivel_command deadman has stopped the car by then."""
+        climb = self._climb
+        now = self._now()
+        if climb is None or now - self._last_tick <= self._ready_timeout:
+            return
+        missing = ', '.join(self._missing_inputs()) or 'none (stamps out of step?)'
+        command = climb.machine.abort(
+            ErrorCode.NOT_READY, f'no complete input for {now - self._last_tick:.1f} s of sim '
+                                 f'time; missing: {missing}')
+        if command is not None:
+            self._publish_command(command, now)
+        self._end(climb, now)
+
+    def _end(self, climb: _ActiveClimb, stamp: float) -> None:
+        """After a failure the swivel holds where it is (the last command) and is released:
+        the controller keeps holding it, and cmd_vel steers again."""
+        self._climb = None
+        if not climb.machine.outcome.success:
+            self._publish_command(Command(0.0, 0.0, 0.0, False), stamp)
+        climb.done.set_result(climb.machine.outcome)
+
+    def _publish_command(self, command: Command, stamp: float) -> None:
         msg = SwivelCommand()
-        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.stamp = Time(nanoseconds=round(stamp * 1e9)).to_msg()
         msg.angle = float(command.angle)
         msg.max_rate = float(command.max_rate)
         msg.drive_speed = float(command.drive_speed)

@@ -32,9 +32,10 @@ except ImportError:  # outside pytest: the repository's helpers (pytest.ini puts
     _REPO = Path(__file__).resolve().parents[2]
     sys.path += [str(_REPO / 'scripts'), str(_REPO / 'tests' / 'support')]
     from swivel_car_testing import next_domain_id, spin_until
-from swivel_car_stack import NodeProcess, start_node
+from swivel_car_stack import NodeProcess, lockstep_parameters, start_node
 
 CLIMB_WALL_LIMIT = 600.0  # [s] guard against a hung stack, not a measurement
+LOCKSTEP_TIMEOUT = 2.0  # [s] wall
 
 
 @dataclass(frozen=True)
@@ -88,12 +89,9 @@ class SimSession:
         joint = {'swivel_joint': 'steering_joint' if robot_variant == 'car_like'
                  else 'swivel_joint'}
         sim_time = {'use_sim_time': True, **joint}
-        # The planner acts on its own sim-time timer, outside the lockstep between sim and
-        # controller: pacing the sim at real time keeps its commands' latency small and
-        # steady, so climbs do not depend on how fast the machine answers.
-        specs = [('swivel_car_sim', 'sim_node',
-                  {'lockstep': True, 'lockstep_timeout': 2.0, 'robot_variant': robot_variant,
-                   'lockstep_real_time_factor': 1.0}),
+        # In lockstep the planner's climbs are deterministic; the pace (real time) is for
+        # this client, which steers by wall time (drive_straight, settle).
+        specs = [('swivel_car_sim', 'sim_node', {'robot_variant': robot_variant}),
                  ('swivel_car_control', 'controller_node', sim_time),
                  ('swivel_car_control', 'odometry_node', sim_time)]
         if planner:
@@ -102,8 +100,9 @@ class SimSession:
         self.processes: list[NodeProcess] = []
         try:
             for package, executable, parameters in specs:
-                self.processes.append(start_node(package, executable, self.domain_id,
-                                                 parameters))
+                self.processes.append(start_node(
+                    package, executable, self.domain_id,
+                    {**parameters, **lockstep_parameters(executable, LOCKSTEP_TIMEOUT)}))
             os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
             self.context = rclpy.Context()
             rclpy.init(context=self.context, domain_id=self.domain_id)
@@ -197,10 +196,14 @@ class SimSession:
             timeout=CLIMB_WALL_LIMIT)
 
     def drive_straight(self, drive_speed: float, seconds: float) -> None:
-        """Hold the steering at 0 and drive for ``seconds`` of wall time, then stop."""
+        """Hold the steering at 0 and drive for ``seconds`` of wall time, then stop. The
+        command is repeated within the controller's swivel_command deadman."""
         for speed, duration in ((drive_speed, seconds), (0.0, 0.5)):
-            self.swivel_command.publish(SwivelCommand(angle=0.0, drive_speed=speed, hold=True))
-            self.settle(duration)
+            end = time.monotonic() + duration
+            while time.monotonic() < end:
+                self.swivel_command.publish(
+                    SwivelCommand(angle=0.0, drive_speed=speed, hold=True))
+                self.settle(min(0.1, end - time.monotonic()))
         self.swivel_command.publish(SwivelCommand(hold=False))
 
     def front_on_top(self, height: float, tolerance: float = 0.015) -> bool:

@@ -60,6 +60,7 @@ class Rig:
         self.executor.add_node(self.node)
         self.car = KinematicCar()
         self.command = None
+        self.received: list[SwivelCommand] = []
         self.node.create_subscription(SwivelCommand, 'swivel_command', self._on_command, 10)
         self.clock = self.node.create_publisher(Clock, '/clock', 10)
         self.joints = self.node.create_publisher(JointState, 'joint_states', 10)
@@ -73,6 +74,7 @@ class Rig:
         spin_until(self.executor, self.action.server_is_ready, 10.0, 'the action server')
 
     def _on_command(self, msg):
+        self.received.append(msg)
         self.command = Command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold)
 
     def publish_state(self, inputs=('joint_states', 'imu', 'odom', 'controller')):
@@ -122,7 +124,9 @@ class Rig:
             while self.command is None and not future.done() and time.monotonic() < deadline:
                 self.executor.spin_once(timeout_sec=0.005)
             if self.command is not None:
-                last, self.command = self.command, None
+                # A release leaves the swivel where it was and stops, as the controller does.
+                last = self.command if self.command.hold else Command(last.angle, 0.0, 0.0, False)
+                self.command = None
             self.car.apply(last)
         spin_until(self.executor, future.done, 10.0, 'the result')
         return future.result()
@@ -256,9 +260,39 @@ def test_action_cancel_stops_the_drive_and_holds_the_swivel(rig):
     assert cancel.done()
     assert wrapped.status == GoalStatus.STATUS_CANCELED
     assert wrapped.result.error_code == ErrorCode.CANCELED
-    last = rig.car.commands[-1]
-    assert last.drive_speed == 0.0 and last.hold
-    assert last.angle == pytest.approx(rig.car.swivel, abs=1e-6)
+    # Stopped with the swivel held where it was, then released: the controller holds it.
+    held, released = rig.received[-2:]
+    assert held.drive_speed == 0.0 and held.hold
+    assert held.angle == pytest.approx(rig.car.swivel, abs=1e-6)
+    assert not released.hold
+
+
+def test_each_command_answers_the_moment_of_its_inputs(rig):
+    rig.warm_up()
+    future = rig.call(**SUCCESSFUL_CLIMB)
+    rig.drive(_Deadline(rig, 0.5))
+    stamps = [m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for m in rig.received]
+    # One command per published state, stamped with that state's time, in order.
+    assert len(stamps) > 20
+    assert all(b == pytest.approx(a + 0.01) for a, b in zip(stamps, stamps[1:]))
+    assert stamps[-1] == pytest.approx(rig.car.time - 0.01)
+    rig.drive(future)
+
+
+def test_inputs_stopping_mid_climb_abort_it(rig):
+    rig.warm_up()
+    future = rig.call(**SUCCESSFUL_CLIMB)
+    rig.drive(_Deadline(rig, 1.0))
+    # The odometry dies: the planner hears no complete moment for ready_timeout (1 s).
+    while not future.done() and rig.car.time < 10.0:
+        rig.publish_state(inputs=('joint_states', 'imu', 'controller'))
+        rig.car.cycles += 1
+        rig.executor.spin_once(timeout_sec=0.005)
+    response = result_of(rig, future)
+    assert response.error_code == ErrorCode.NOT_READY
+    assert 'odom' in response.message
+    assert 0.9 <= response.outcome.duration <= 1.05  # to the last complete moment
+    assert not rig.received[-1].hold
 
 
 class _Deadline:

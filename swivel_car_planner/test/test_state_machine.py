@@ -136,6 +136,21 @@ def assert_safe_abort(machine, car, code):
     assert machine.update(car.observe()) == final
 
 
+def test_abort_between_observations_holds_the_swivel_where_last_seen():
+    machine, _ = start()
+    assert machine.abort(ErrorCode.NOT_READY, 'inputs stopped') is None
+    assert machine.outcome.error_code == ErrorCode.NOT_READY and not machine.outcome.success
+
+    machine, _ = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.step == Step.ADVANCE)
+    machine.update(car.observe())  # the last observation before the inputs stop
+    command = machine.abort(ErrorCode.NOT_READY, 'inputs stopped')
+    car.apply(command)
+    assert_safe_abort(machine, car, ErrorCode.NOT_READY)
+    assert machine.outcome.duration > 0.0
+
+
 def test_cancel_stops_the_drive_and_holds_the_swivel():
     machine, _ = start()
     car = KinematicCar()

@@ -11,8 +11,8 @@ import itertools
 import os
 
 from swivel_car_stack import (  # noqa: F401  (re-exported for the tests)
-    INSTALL_DIR, REPO_ROOT, NodeProcess, config_path, executable_path, ros_environment,
-    spin_until, start_node)
+    INSTALL_DIR, REPO_ROOT, NodeProcess, config_path, executable_path, lockstep_parameters,
+    ros_environment, spin_until, start_node)
 
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
 # stragglers are never heard. The base spreads concurrent pytest processes apart.

@@ -47,6 +47,10 @@ class ControllerConfig:
     cmd_vel_timeout : float
         Deadman: a cmd_vel older than this stops the drive and holds the swivel; 0 disables.
         # [s]
+    swivel_command_timeout : float
+        Deadman for the planner: a held swivel_command older than this is released (the drive
+        stops, the swivel holds, cmd_vel steers again); 0 disables. The planner repeats its
+        command every control cycle. # [s]
     slowdown_start, slowdown_stop : float
         Swivel error (target - measured) below which the drive runs at full speed, and above
         which it stops; cos(error) between. # [rad]
@@ -64,6 +68,7 @@ class ControllerConfig:
     max_angular_velocity: float = 2.0  # [rad/s]
     max_angular_acceleration: float = 4.0  # [rad/s^2]
     cmd_vel_timeout: float = 0.5  # [s]
+    swivel_command_timeout: float = 0.5  # [s]
     slowdown_start: float = 0.15  # [rad]
     slowdown_stop: float = 0.6  # [rad]
     tip_over_margin: float = 0.1  # [rad]
@@ -92,6 +97,7 @@ class SwivelCommandRequest:
     angle: float  # [rad]
     max_rate: float  # [rad/s], 0 = controller default
     drive_speed: float  # [rad/s] at the wheels
+    stamp: float  # [s] the command's time, for the deadman
 
 
 @dataclass(frozen=True)
@@ -107,6 +113,7 @@ class ControlOutput:
     v_out: float  # [m/s] commanded forward speed
     omega_out: float  # [rad/s] yaw rate the car will have at this speed once steered
     cmd_vel_timed_out: bool
+    swivel_command_timed_out: bool
 
 
 class SwivelController:
@@ -165,8 +172,9 @@ class SwivelController:
         self._cmd_vel = (float(v), float(omega), float(stamp))
 
     def set_swivel_command(self, angle: float, max_rate: float, drive_speed: float,
-                           hold: bool) -> None:
-        """Take the planner's direct command; ``hold=False`` releases it to cmd_vel.
+                           hold: bool, stamp: float) -> None:
+        """Take the planner's direct command of time ``stamp`` [s]; ``hold=False`` releases
+        it to cmd_vel.
 
         Raises
         ------
@@ -178,7 +186,7 @@ class SwivelController:
             self._swivel_command = None
             return
         for name, value in (('angle', angle), ('max_rate', max_rate),
-                            ('drive_speed', drive_speed)):
+                            ('drive_speed', drive_speed), ('stamp', stamp)):
             if not math.isfinite(value):
                 raise ValueError(f'swivel_command {name} is {value!r}: refused')
         if max_rate < 0.0:
@@ -195,7 +203,7 @@ class SwivelController:
                 f'swivel_command angle {angle!r} rad breaks the tip-over rule (thesis eq. 72) '
                 f'with margin {self.config.tip_over_margin!r} rad: refused')
         self._swivel_command = SwivelCommandRequest(float(angle), float(max_rate),
-                                                    float(drive_speed))
+                                                    float(drive_speed), float(stamp))
 
     def step(self, t: float, measured: float, measured_rate: float) -> ControlOutput:
         """One control period at time ``t`` [s] with the measured swivel angle [rad] and rate
@@ -212,6 +220,10 @@ class SwivelController:
         timed_out = False
         max_rate = None
         command = self._swivel_command
+        command_timed_out = command is not None and 0.0 < self.config.swivel_command_timeout \
+            < t - command.stamp
+        if command_timed_out:
+            self._swivel_command = command = None
         if command is not None:
             source = SOURCE_SWIVEL_COMMAND
             self._target = command.angle
@@ -249,7 +261,7 @@ class SwivelController:
         v_out = drive * self.p.r
         omega_out = planar.curvature_for_swivel(self.p, self._target) * v_out
         return ControlOutput(pid.torque, drive, set_point, self._target, pid, source, v_out,
-                             omega_out, timed_out)
+                             omega_out, timed_out, command_timed_out)
 
     def _tightest_turn_speed(self, omega: float, measured: float) -> float:
         """Forward speed [m/s] giving the yaw rate ``omega`` [rad/s] at the *measured* swivel.

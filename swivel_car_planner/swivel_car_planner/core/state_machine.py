@@ -193,6 +193,16 @@ class ClimbStateMachine:
         """End the climb at the next ``update``: stop the drive and hold the swivel."""
         self._cancel_requested = True
 
+    def abort(self, code: ErrorCode, message: str) -> Command | None:
+        """End the climb between observations (its inputs stopped): the drive stops and the
+        swivel holds where it was last seen; None if it was never observed."""
+        if self.outcome is not None:
+            return self._final_command()
+        if self._last is None:
+            self.outcome = Outcome(False, code, message, 0.0, 0.0, 0.0, 0.0, 0.0)
+            return None
+        return self._finish(self._last, code, message)
+
     def update(self, obs: Observation) -> Command:
         """Advance the climb by one observation; returns the command to send now."""
         if self.outcome is not None:
