@@ -5,9 +5,8 @@ ground truth, ours (tricycle with a variable offset steering wheel) beside a pla
 
 Runs the sim's physics (``swivel_car_sim.physics.SwivelCarSim``, the same class ``sim_node``
 wraps) in lockstep with the controller core and the odometry integrators in one process, so
-the figures are deterministic and independent of machine load (straight, arc and turn on the
-spot also run through the real node executables in ``test/test_system.py``). Prints; asserts
-nothing.
+the figures are deterministic and independent of machine load (every route also runs through
+the real node executables in ``test/test_system_routes.py``). Prints; asserts nothing.
 """
 
 from __future__ import annotations

@@ -1,0 +1,185 @@
+"""System test: the benchmark's standard routes (``swivel_car_control.benchmark.routes``)
+driven through the real executables, each its own process: sim_node in lockstep,
+controller_node, odometry_node. The odometry's end pose is checked against the sim's ground
+truth, as the benchmark does in-process.
+
+The route driver acts once per controller state, like the planner: its swivel commands are
+stamped with the state they answer and the controller waits for them (the lockstep chain of
+docs/architecture.md), so the swivel routes are deterministic. Its cmd_vel segments are taken
+whenever they arrive, a few control periods late on a busy machine; that shifts the route a
+little, not the odometry's error against the truth of the same run.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import pytest
+import rclpy
+from geometry_msgs.msg import TwistStamped
+from nav_msgs.msg import Odometry
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from std_srvs.srv import Empty
+from swivel_car_model.params import SwivelCarParams
+from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
+from swivel_car_msgs.srv import ResetSimulation
+from swivel_car_testing import (
+    lockstep_parameters, next_domain_id, spin_until, start_node)
+
+from swivel_car_control.benchmark import Segment, routes
+from swivel_car_control.gains import TUNED_GAINS
+
+SETTLE = 1.0  # [s] sim time standing still at the end of a route, as the benchmark
+# Our odometry's end-pose error, % of the distance travelled; the in-process benchmark
+# measures 0.003-1.18 % on these routes (the misses over 1 % are rear-wheel slip in tight turns).
+MAX_ERROR_PERCENT = 2.0
+# [m] The sweep at standstill moves base_link 8.7 cm (the swivel's reaction), too little to
+# divide by: typically 0.4 mm; one run in about ten gave 6 mm (unexplained, see the notes).
+MAX_STANDSTILL_ERROR = 0.01
+
+
+def _seconds(stamp) -> float:
+    return stamp.sec + 1e-9 * stamp.nanosec
+
+
+def _yaw(q) -> float:
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+class RouteDriver:
+    """Drives a route's segments, one command per controller state."""
+
+    def __init__(self, context: Context) -> None:
+        self.node = rclpy.create_node('route_driver', context=context)
+        self.executor = SingleThreadedExecutor(context=context)
+        self.executor.add_node(self.node)
+        self.truth: dict[float, Odometry] = {}  # by stamp [s]
+        self.odom: dict[float, Odometry] = {}
+        self.time = -1.0  # [s] stamp of the last controller state
+        self.plan: list[tuple[float, Segment]] = []  # (end time [s], segment)
+        self.cmd_vel = self.node.create_publisher(TwistStamped, 'cmd_vel', 10)
+        self.swivel = self.node.create_publisher(SwivelCommand, 'swivel_command', 10)
+        self.node.create_subscription(
+            Odometry, 'ground_truth/odom',
+            lambda m: self.truth.__setitem__(_seconds(m.header.stamp), m), 100)
+        self.node.create_subscription(
+            Odometry, 'odom', lambda m: self.odom.__setitem__(_seconds(m.header.stamp), m), 100)
+        self.node.create_subscription(SwivelControllerState, 'controller/controller_state',
+                                      self._on_state, 100)
+        self.reset_sim = self.node.create_client(ResetSimulation, 'sim/reset')
+        self.reset_odometry = self.node.create_client(Empty, 'odometry/reset')
+
+    def _on_state(self, msg: SwivelControllerState) -> None:
+        self.time = _seconds(msg.header.stamp)
+        while self.plan and self.time >= self.plan[0][0]:
+            self.plan.pop(0)
+            if not self.plan:
+                self.swivel.publish(SwivelCommand(header=msg.header, hold=False))
+        if not self.plan:
+            return
+        segment = self.plan[0][1]
+        if segment.kind == 'swivel':
+            self.swivel.publish(SwivelCommand(header=msg.header, angle=segment.a,
+                                              drive_speed=segment.b, hold=True))
+        else:
+            self.swivel.publish(SwivelCommand(header=msg.header, hold=False))
+            command = TwistStamped(header=msg.header)
+            command.twist.linear.x, command.twist.angular.z = segment.a, segment.b
+            self.cmd_vel.publish(command)
+
+    def call(self, client, request) -> None:
+        spin_until(self.executor, client.service_is_ready, 60.0, client.srv_name)
+        future = client.call_async(request)
+        spin_until(self.executor, future.done, 30.0, client.srv_name)
+        assert getattr(future.result(), 'success', True), future.result()
+
+    def run(self, segments: list[Segment]) -> float:
+        """Drive ``segments`` from the next controller state on; returns their end time."""
+        end = self.time
+        plan = []
+        for segment in segments:
+            end += segment.duration
+            plan.append((end, segment))
+        self.plan = plan
+        spin_until(self.executor, lambda: not self.plan, 600.0, 'the segments')
+        return end
+
+    def wait(self, seconds: float, what: str) -> None:
+        end = self.time + seconds
+        spin_until(self.executor, lambda: self.time >= end, 30.0, what)
+
+    def drive(self, segments: list[Segment]) -> tuple[Odometry, Odometry, float]:
+        """From the origin at rest: drive, then stand for SETTLE. Returns the odometry and
+        the ground truth of one moment at the end, and the distance the truth travelled."""
+        # The swivel back to 0 first: the controller would turn a reset swivel back to the
+        # angle it last held.
+        self.run([Segment(1.5, 'swivel', 0.0, 0.0)])
+        self.call(self.reset_sim, ResetSimulation.Request(remove_obstacles=True))
+        self.wait(0.3, 'the car to settle after the reset')
+        self.call(self.reset_odometry, Empty.Request())
+        self.wait(0.2, 'the odometry reset to be in')
+        self.truth.clear()
+        self.odom.clear()
+        start = self.time
+        end = self.run(segments + [Segment(SETTLE, 'cmd_vel', 0.0, 0.0)])
+
+        def common_stamp():
+            return min((t for t in self.odom if t >= end and t in self.truth), default=None)
+
+        spin_until(self.executor, lambda: common_stamp() is not None, 30.0, 'the end pose')
+        stamp = common_stamp()
+        truth = [self.truth[t] for t in sorted(self.truth) if start <= t <= stamp]
+        distance = sum(math.hypot(b.pose.pose.position.x - a.pose.pose.position.x,
+                                  b.pose.pose.position.y - a.pose.pose.position.y)
+                       for a, b in zip(truth, truth[1:]))
+        return self.odom[stamp], self.truth[stamp], distance
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.node.destroy_node()
+
+
+@pytest.fixture(scope='module')
+def driver():
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    domain_id = next_domain_id()
+    context = Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    # As fast as the chain answers: nothing here acts on wall time.
+    processes = [start_node(package, executable, domain_id, {
+        'use_sim_time': True, **lockstep_parameters(executable, 2.0, real_time_factor=0.0)})
+        for package, executable in (('swivel_car_sim', 'sim_node'),
+                                    ('swivel_car_control', 'controller_node'),
+                                    ('swivel_car_control', 'odometry_node'))]
+    route_driver = RouteDriver(context)
+    try:
+        spin_until(route_driver.executor, lambda: route_driver.time > 0.0 and route_driver.odom,
+                   60.0, 'the stack')
+        yield route_driver
+    finally:
+        route_driver.close()
+        codes = {process.name: process.stop() for process in processes}
+        rclpy.try_shutdown(context=context)
+    assert all(code == 0 for code in codes.values()), codes
+
+
+P = SwivelCarParams(**{**SwivelCarParams().__dict__, **TUNED_GAINS})
+ROUTES = routes(P)
+
+
+@pytest.mark.parametrize('name', list(ROUTES))
+def test_route_odometry_against_ground_truth(driver, name):
+    odom, truth, distance = driver.drive(ROUTES[name])
+    error = math.hypot(odom.pose.pose.position.x - truth.pose.pose.position.x,
+                       odom.pose.pose.position.y - truth.pose.pose.position.y)
+    heading = abs(math.remainder(_yaw(odom.pose.pose.orientation)
+                                 - _yaw(truth.pose.pose.orientation), 2.0 * math.pi))
+    print(f'{name}: {distance:.3f} m travelled, odometry end error {error:.4f} m '
+          f'({100.0 * error / max(distance, 1e-9):.2f} %), heading {heading:.4f} rad')
+    if name == 'swivel_sweep_standstill':
+        assert error < MAX_STANDSTILL_ERROR
+    else:
+        assert distance > 1.0
+        assert 100.0 * error / distance < MAX_ERROR_PERCENT
