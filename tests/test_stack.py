@@ -122,11 +122,10 @@ def stack(ros_domain) -> Iterator[Stack]:
 
 
 def test_drive_then_climb_a_step(stack: Stack):
+    stack.wait_planner_ready()
     start = stack.x()
     stack.drive(0.3, 2.0)
     assert stack.x() - start > 0.4, 'cmd_vel did not move the car forward'
-    stack.drive(0.0, 1.0)
-    assert stack.speed() < 0.01, 'a zero cmd_vel did not stop the car'
 
     p = SwivelCarParams()
     # The planner needs room to turn to its approach heading; the rear axle climbs up to
@@ -139,9 +138,11 @@ def test_drive_then_climb_a_step(stack: Stack):
     stack.spin_until(spawned.done, 30.0, 'spawn_obstacle')
     assert spawned.result().success, spawned.result().message
 
-    stack.wait_planner_ready()
+    # Asked while still rolling on the last cmd_vel: the planner stops the car first.
+    assert stack.speed() > 0.2
     response = stack.climb.call_async(ClimbStep.Request(
-        step_height=height, step_distance=distance, step_yaw=0.0, plan_only=False))
+        step_height=height, step_distance=edge_x - p.wheelbase - stack.x(), step_yaw=0.0,
+        plan_only=False))
     stack.spin_until(response.done, 600.0, 'climb_step')
     result = response.result()
     assert result.success, f'{result.error_code}: {result.message}'
@@ -169,6 +170,9 @@ def test_killed_controller_stops_the_car_and_a_restart_recovers(stack: Stack):
     assert stack.x() > x_before + 0.5, (
         f"the restarted controller did not drive the car:\n"
         f"{stack.processes['controller'].output()[-3000:]}")
+    stack.drive(0.0, 1.0)
+    assert stack.speed() < 0.01, 'a zero cmd_vel did not stop the car'
+
 
 
 def test_killed_planner_mid_climb_stops_the_car_and_a_restart_recovers(stack: Stack):

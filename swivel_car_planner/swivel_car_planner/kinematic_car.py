@@ -35,6 +35,7 @@ class KinematicCar:
         self.extra_pitch = 0.0  # [rad] added nose-down pitch
         self.extra_yaw = 0.0  # [rad] added to the IMU heading (a slip odometry cannot see)
         self.sag = 0.0  # [rad] how far short of its set point the loaded swivel settles
+        self.speed = 0.0  # [m/s] forward, as the drive makes it (no inertia)
         self.commands: list[Command] = []
 
     def observe(self) -> Observation:
@@ -44,7 +45,7 @@ class KinematicCar:
             swivel=self.swivel, swivel_rate=self.rate, set_point=self.set_point,
             torque=10.0 * self.swivel,
             pitch=-float(kinematics.lift_angle(self.p, self.swivel)) + self.extra_pitch,
-            roll=0.0, imu_yaw=self.odometry.yaw + self.extra_yaw)
+            roll=0.0, imu_yaw=self.odometry.yaw + self.extra_yaw, speed=self.speed)
 
     def apply(self, command: Command) -> None:
         """Follow ``command`` for one control period."""
@@ -59,6 +60,7 @@ class KinematicCar:
         self.swivel = new
         wheel = 0.0 if self.blocked else command.drive_speed
         self.odometry.update(self.swivel, self.rate, wheel, DT)
+        self.speed = self.odometry.v
         self.cycles += 1
 
     @property

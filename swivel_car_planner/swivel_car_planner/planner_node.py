@@ -141,7 +141,7 @@ class PlannerNode(Node):
     def _on_odom(self, msg: Odometry) -> None:
         q = msg.pose.pose.orientation
         self._add('odom', msg, (msg.pose.pose.position.x, msg.pose.pose.position.y,
-                                yaw_of(q.x, q.y, q.z, q.w)))
+                                yaw_of(q.x, q.y, q.z, q.w), msg.twist.twist.linear.x))
 
     def _on_joint_states(self, msg: JointState) -> None:
         if self._swivel_joint not in msg.name:
@@ -174,13 +174,14 @@ class PlannerNode(Node):
 
     @staticmethod
     def _observation(tick: Tick) -> Observation:
-        x, y, yaw = tick.values['odom']
+        x, y, yaw, speed = tick.values['odom']
         swivel, swivel_rate = tick.values['joint_states']
         roll, pitch, imu_yaw = tick.values['imu']
         set_point, torque = tick.values[_CONTROLLER_STATE]
         return Observation(
             time=tick.time, x=x, y=y, yaw=yaw, swivel=swivel, swivel_rate=swivel_rate,
-            set_point=set_point, torque=torque, roll=roll, pitch=pitch, imu_yaw=imu_yaw)
+            set_point=set_point, torque=torque, roll=roll, pitch=pitch, imu_yaw=imu_yaw,
+            speed=speed)
 
     # --- the climb ------------------------------------------------------------------------
 

@@ -261,6 +261,7 @@ def test_action_cancel_stops_the_drive_and_holds_the_swivel(rig):
     assert wrapped.status == GoalStatus.STATUS_CANCELED
     assert wrapped.result.error_code == ErrorCode.CANCELED
     # Stopped with the swivel held where it was, then released: the controller holds it.
+    spin_until(rig.executor, lambda: not rig.received[-1].hold, 10.0, 'the release')
     held, released = rig.received[-2:]
     assert held.drive_speed == 0.0 and held.hold
     assert held.angle == pytest.approx(rig.car.swivel, abs=1e-6)
@@ -292,7 +293,7 @@ def test_inputs_stopping_mid_climb_abort_it(rig):
     assert response.error_code == ErrorCode.NOT_READY
     assert 'odom' in response.message
     assert 0.9 <= response.outcome.duration <= 1.05  # to the last complete moment
-    assert not rig.received[-1].hold
+    spin_until(rig.executor, lambda: not rig.received[-1].hold, 10.0, 'the release')
 
 
 class _Deadline:

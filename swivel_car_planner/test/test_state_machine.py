@@ -235,3 +235,20 @@ def test_reaching_the_lift_point_misaligned_fails_safely():
     run(machine, car)
     assert_safe_abort(machine, car, ErrorCode.FAILED)
     assert 'heading' in machine.outcome.message
+
+
+def test_a_car_asked_while_moving_first_stops_holding_its_swivel():
+    car = KinematicCar()
+    for _ in range(50):
+        car.apply(Command(0.2, 0.0, 4.0, True))
+    assert car.speed > 0.2
+    machine, plan = start()
+    first = machine.update(car.observe())
+    assert machine.step == Step.STOP and machine.phase == Phase.APPROACH
+    assert first.drive_speed == 0.0 and first.hold
+    assert first.angle == pytest.approx(car.swivel)
+    car.apply(first)  # the kinematic car stops at once
+    approach = machine.update(car.observe())
+    assert machine.step == Step.APPROACH and approach.drive_speed > 0.0
+    run(machine, car)
+    assert machine.outcome.success, machine.outcome.message

@@ -47,6 +47,9 @@ class PlannerConfig:
     swivel_tolerance: float = _field(0.04, 'swivel counts as at its target within this [rad]')
     settle_rate: float = _field(0.05, 'swivel counts as at rest below this rate [rad/s]')
     settle_time: float = _field(0.3, 'swivel at its target and at rest this long [s]')
+    stop_speed: float = _field(
+        0.02, 'a climb asked while the car is faster than this first stops it, the swivel '
+              'held [m/s]')
     rear_slip_allowance: float = _field(
         0.25, 'odometry past the edge beyond rest_margin with the car still pitched: the '
         'rear axle failed to climb [m]')
@@ -82,7 +85,8 @@ class PlannerConfig:
                 raise ValueError(f'{item.name} must be >= 0, got {value!r}')
         for name in ('torque_limit', 'max_step_distance', 'max_step_yaw', 'max_lead_angle',
                      'approach_speed', 'climb_speed', 'rear_speed', 'swivel_rate', 'max_steer',
-                     'max_swivel_command', 'swivel_tolerance', 'settle_rate', 'stall_progress',
+                     'max_swivel_command', 'swivel_tolerance', 'settle_rate', 'stop_speed',
+                     'stall_progress',
                      'stall_time', 'slip_yaw_tolerance', 'no_progress_time', 'min_progress',
                      'time_allowance'):
             if getattr(self, name) <= 0.0:

@@ -3,6 +3,9 @@
 One ``update`` per control cycle (the node calls it from a sim-time timer). Steps (and the
 action phase each one reports)::
 
+    STOP             only if the car is moving when asked: drive 0, the swivel
+                     held, until odometry says it stands (the edge stays where
+                     the request put it, relative to the car when asked)       APPROACH
     APPROACH         drive to the lift point, steering to the planned heading   APPROACH
     LIFT             stop; swivel to the plan's angle: the leading front wheel
                      rises above the step                                       LIFT
@@ -57,7 +60,8 @@ from swivel_car_planner.core.plan import ClimbPlan
 class Step(Enum):
     """Internal steps of the climb: (action phase, share of the progress at its start)."""
 
-    APPROACH = (Phase.APPROACH, 0.0)
+    STOP = (Phase.APPROACH, 0.0)
+    APPROACH = (Phase.APPROACH, 0.05)
     LIFT = (Phase.LIFT, 0.2)
     ADVANCE = (Phase.ADVANCE, 0.3)
     SET_DOWN = (Phase.SET_DOWN, 0.4)
@@ -94,6 +98,7 @@ class Observation:
     pitch: float  # [rad] base_link pitch, REP-103: positive nose down
     roll: float  # [rad]
     imu_yaw: float  # [rad] heading from the IMU's orientation (any fixed offset)
+    speed: float  # [m/s] odometry forward speed of base_link
 
 
 @dataclass(frozen=True)
@@ -226,6 +231,10 @@ class ClimbStateMachine:
         config, plan = self._config, self._plan
         side = plan.lifted_side
         step = self._step
+        if step == Step.STOP:
+            if abs(obs.speed) <= config.stop_speed:
+                return self._enter(Step.APPROACH, obs)
+            return Command(self._last_command, config.swivel_rate, 0.0, True)
         if step == Step.APPROACH:
             if self._lifted_wheel_distance(obs) >= -plan.lead_distance:
                 error = plan.approach_heading - self._edge.relative_heading(self._heading(obs))
@@ -366,6 +375,8 @@ class ClimbStateMachine:
                    self._wheel_distance(obs, 0.0, -self._p.h))
 
     def _progress_quantity(self, obs: Observation) -> float:
+        if self._step == Step.STOP:
+            return abs(obs.speed)
         if self._step in (Step.APPROACH, Step.ADVANCE):
             return self._lifted_wheel_distance(obs)
         if self._step == Step.SECOND_ADVANCE:
@@ -381,10 +392,15 @@ class ClimbStateMachine:
                                            self._step_distance, self._step_yaw)
         self._start_time = obs.time
         self._yaw_offset = obs.imu_yaw - obs.yaw
-        self._step = Step.APPROACH
         self._progress_ref = (obs.time, 0.0)
         self._stall_ref = (obs.time, math.inf)
-        self._span = (self._lifted_wheel_distance(obs), -self._plan.lead_distance)
+        if abs(obs.speed) > self._config.stop_speed:
+            self._step = Step.STOP
+            self._last_command = obs.swivel
+            self._span = (abs(obs.speed), 0.0)
+        else:
+            self._step = Step.APPROACH
+            self._span = (self._lifted_wheel_distance(obs), -self._plan.lead_distance)
 
     def _measure(self, obs: Observation) -> None:
         if self._last is not None:
