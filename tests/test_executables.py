@@ -43,9 +43,12 @@ def test_executable_installed_and_starts(ros_domain, package, executable):
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(probe)
     try:
-        spin_until(executor, lambda: not process.running() or len(
-            [n for n in probe.get_node_names() if n != 'executable_probe']) > 0,
-            30.0, f'{executable} to join the ROS graph')
+        # The node is named after its executable (sim_node: 'sim'). Waiting for that name,
+        # not any node, keeps a straggler of an earlier test from ending the wait while this
+        # one still imports (SIGINT then would not exit cleanly).
+        name = executable.removesuffix('_node')
+        spin_until(executor, lambda: not process.running() or name in probe.get_node_names(),
+                   30.0, f'{executable} to join the ROS graph as {name}')
         assert process.running(), process.output()
         assert process.stop() == 0, process.output()
     finally:
