@@ -37,8 +37,9 @@ CONFIG_DESCRIPTIONS = {
     'max_angular_velocity': 'yaw rate limit [rad/s]',
     'max_angular_acceleration': 'yaw acceleration limit [rad/s^2]',
     'cmd_vel_timeout': 'deadman: older cmd_vel stops the drive, holds the swivel; 0 disables [s]',
-    'swivel_command_timeout': 'deadman: an older held swivel_command is released (drive stops, '
-                              'swivel holds, cmd_vel steers again); 0 disables [s]',
+    'swivel_command_timeout': 'deadman: a held swivel_command not renewed for this long (node '
+                              'clock, from receipt) is released: drive stops, swivel holds, '
+                              'cmd_vel steers again; 0 disables [s]',
     'slowdown_start': 'swivel error below which the drive runs at full speed [rad]',
     'slowdown_stop': 'swivel error above which the drive stops; cos(error) between [rad]',
     'tip_over_margin': 'margin on thesis eq. 72, (pi - phi)/2 - theta1 >= margin [rad]',
@@ -81,6 +82,8 @@ class ControllerNode(Node):
         self._warned_zero_stamp: set[str] = set()
         self._last_time: float | None = None  # [s] stamp of the last joint_states answered
         self._heard_command_time = -math.inf  # [s] stamp of the last stamped swivel_command
+        self._held_stamped = False  # the held swivel_command came stamped: it takes part in
+        # the lockstep
         self._pending: JointState | None = None  # joint_states waiting for that command
         self._pending_since = 0.0  # [s] wall
         self._planner_late = False
@@ -140,18 +143,20 @@ class ControllerNode(Node):
 
     def _on_swivel_command(self, msg: SwivelCommand) -> None:
         held_before = self._core.swivel_command is not None
-        if not is_zero_stamp(msg.header.stamp):
+        stamped = not is_zero_stamp(msg.header.stamp)
+        if stamped:
             # Even a refused command answers its cycle: the lockstep wait is over.
             self._heard_command_time = stamp_to_seconds(msg.header.stamp)
             self._planner_late = False
         try:
-            self._core.set_swivel_command(
-                msg.angle, msg.max_rate, msg.drive_speed, msg.hold,
-                self._command_time(msg.header.stamp, 'swivel_command',
-                                   self._core.config.swivel_command_timeout))
+            # The deadman counts from receipt: a planner that lags behind a lockstep sim
+            # running ahead of it (before its first command held the sim back) is not dead.
+            self._core.set_swivel_command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold,
+                                          self.get_clock().now().nanoseconds * 1e-9)
         except ValueError as error:
             self.get_logger().error(str(error), throttle_duration_sec=1.0)
         else:
+            self._held_stamped = stamped
             if msg.hold and not held_before:
                 self.get_logger().info(
                     f'swivel_command takes over: angle {msg.angle:.3f} rad, drive '
@@ -165,7 +170,7 @@ class ControllerNode(Node):
         """Lockstep with a stamped swivel_command held: ``msg`` waits for the command that
         answers the previous joint_states (the planner's pipeline is one cycle deep)."""
         if (not self._lockstep_swivel_command or self._planner_late or self._last_time is None
-                or self._core.swivel_command is None):
+                or self._core.swivel_command is None or not self._held_stamped):
             return False
         return (stamp_to_seconds(msg.header.stamp) > self._last_time
                 > self._heard_command_time)

@@ -182,7 +182,7 @@ def stamped_swivel_command(t, angle, hold=True):
 
 
 def test_lockstep_waits_for_the_planners_command_of_the_previous_state():
-    harness = Harness(ControllerNode, {'lockstep_swivel_command': True, 'lockstep_wait': 0.5})
+    harness = Harness(ControllerNode, {'lockstep_swivel_command': True, 'lockstep_wait': 3.0})
     try:
         commands = harness.record(ActuatorCommand, 'actuator_command')
         states = harness.record(SwivelControllerState, 'controller/controller_state')
@@ -218,7 +218,7 @@ def test_lockstep_waits_for_the_planners_command_of_the_previous_state():
         # A planner that does not answer: after lockstep_wait the controller goes on, and
         # waits no more until the next command.
         harness.joints.publish(joint_state(1.03))
-        assert state_of(1.03, 5.0).target == pytest.approx(0.4)
+        assert state_of(1.03, 10.0).target == pytest.approx(0.4)
         step(harness, 1.04)
 
         # The next command re-arms the wait; a release ends it.
@@ -234,6 +234,16 @@ def test_lockstep_waits_for_the_planners_command_of_the_previous_state():
         swivel.publish(stamped_swivel_command(1.05, 0.0, hold=False))
         assert state_of(1.06).source == 'hold'
         step(harness, 1.07)  # released: no wait
+
+        # A command with a zero stamp (a hand-made one, not the planner's) is held without
+        # any wait.
+        swivel.publish(SwivelCommand(angle=0.2, hold=True))
+        for _ in range(20):
+            harness.executor.spin_once(timeout_sec=0.01)
+        for t in (1.08, 1.09):
+            harness.joints.publish(joint_state(t))
+            state = state_of(t, 1.5)  # well within lockstep_wait: no wait
+        assert state.target == pytest.approx(0.2)
     finally:
         harness.close()
 

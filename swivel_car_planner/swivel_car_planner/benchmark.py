@@ -157,7 +157,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument('--trials', type=int, default=3, help='approaches per height')
     parser.add_argument('--seed', type=int, default=1)
     parser.add_argument('--car-like-seconds', type=float, default=6.0,
-                        help='[s] wall time the baseline drives at each step')
+                        help='[s] sim time the baseline drives at each step')
     parser.add_argument('--skip-car-like', action='store_true')
     args = parser.parse_args(argv)
     rng = random.Random(args.seed)

@@ -102,7 +102,8 @@ class PlannerNode(Node):
         self._climb: _ActiveClimb | None = None
         self._received: dict[str, float] = {}  # topic -> sim time of its last message [s]
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
-        self._last_tick = 0.0  # [s] sim time of the last tick of the running climb
+        self._last_tick = 0.0  # [s] node clock when the running climb last had a tick
+        self._quiet_checks = 0  # input checks in a row that saw no tick
 
         self.create_subscription(Odometry, 'odom', self._on_odom, 10)
         self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
@@ -210,6 +211,7 @@ class PlannerNode(Node):
             return self._failure(ErrorCode.BUSY, 'a climb is already running')
         self._climb = climb
         self._last_tick = self._now()
+        self._quiet_checks = 0
         self.get_logger().info(
             f'climbing a {request.step_height:.3f} m step {request.step_distance:.2f} m ahead: '
             f'swivel {plan.swivel_angle:.3f} rad, approach heading '
@@ -231,7 +233,8 @@ class PlannerNode(Node):
         climb = self._climb
         if climb is None:
             return
-        self._last_tick = tick.time
+        self._last_tick = self._now()
+        self._quiet_checks = 0
         if climb.goal_handle is not None and climb.goal_handle.is_cancel_requested:
             climb.machine.cancel()
         command = climb.machine.update(self._observation(tick))
@@ -243,15 +246,22 @@ class PlannerNode(Node):
 
     def _check_inputs_alive(self) -> None:
         """A climb whose inputs stopped (odometry or controller gone) ends: the controller's
-        swivel_command deadman has stopped the car by then."""
+        swivel_command deadman has stopped the car by then.
+
+        Only after two checks in a row without a tick: after the executor was held up (a long
+        plan), this timer runs before the queued inputs and would see a stale tick."""
         climb = self._climb
-        now = self._now()
-        if climb is None or now - self._last_tick <= self._ready_timeout:
+        if climb is None:
             return
-        missing = ', '.join(self._missing_inputs()) or 'none (stamps out of step?)'
+        self._quiet_checks += 1
+        now = self._now()
+        if self._quiet_checks < 2 or now - self._last_tick <= self._ready_timeout:
+            return
+        missing = ', '.join(self._missing_inputs()) or 'none'
         command = climb.machine.abort(
             ErrorCode.NOT_READY, f'no complete input for {now - self._last_tick:.1f} s of sim '
-                                 f'time; missing: {missing}')
+                                 f'time at {now:.2f} s; missing: {missing}; '
+                                 f'{self._sync.describe()}')
         if command is not None:
             self._publish_command(command, now)
         self._end(climb, now)

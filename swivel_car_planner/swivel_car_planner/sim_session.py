@@ -20,7 +20,7 @@ from nav_msgs.msg import Odometry
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.executors import SingleThreadedExecutor
-from std_srvs.srv import Empty
+from std_srvs.srv import Empty, SetBool
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
@@ -89,8 +89,10 @@ class SimSession:
         joint = {'swivel_joint': 'steering_joint' if robot_variant == 'car_like'
                  else 'swivel_joint'}
         sim_time = {'use_sim_time': True, **joint}
-        # In lockstep the planner's climbs are deterministic; the pace (real time) is for
-        # this client, which steers by wall time (drive_straight, settle).
+        # In the lockstep chain the planner's climbs do not depend on the machine's load. The
+        # pace (real time) is for the time before a climb's first command: then the sim runs
+        # free of the planner, and faster it would flood the planner with messages (seen:
+        # 3 s to take a request, its first commands 13 s of sim time late).
         specs = [('swivel_car_sim', 'sim_node', {'robot_variant': robot_variant}),
                  ('swivel_car_control', 'controller_node', sim_time),
                  ('swivel_car_control', 'odometry_node', sim_time)]
@@ -113,6 +115,7 @@ class SimSession:
             self._stop_processes()
             raise
         self.truth: GroundTruth | None = None
+        self.time = 0.0  # [s] sim time of the last ground truth
         self.controller_state: SwivelControllerState | None = None
         self.odom_count = 0
         self.node.create_subscription(Odometry, 'ground_truth/odom', self._on_truth, 10)
@@ -121,6 +124,7 @@ class SimSession:
                                       self._on_controller_state, 10)
         self.spawn_client = self.node.create_client(SpawnObstacle, 'sim/spawn_obstacle')
         self.reset_client = self.node.create_client(ResetSimulation, 'sim/reset')
+        self.pause_client = self.node.create_client(SetBool, 'sim/set_paused')
         self.odometry_reset = self.node.create_client(Empty, 'odometry/reset')
         self.climb_client = self.node.create_client(ClimbStep, 'climb_step')
         self.climb_action = ActionClient(self.node, ClimbStepAction, 'climb_step')
@@ -129,6 +133,7 @@ class SimSession:
 
     def _on_truth(self, msg: Odometry) -> None:
         self.truth = GroundTruth.from_msg(msg)
+        self.time = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
 
     def _on_odom(self, msg: Odometry) -> None:
         self.odom_count += 1
@@ -141,7 +146,8 @@ class SimSession:
 
     def wait_ready(self, timeout: float = 60.0) -> None:
         """Until the sim, the controller and the odometry publish and the services are up."""
-        clients = [self.spawn_client, self.reset_client, self.odometry_reset]
+        clients = [self.spawn_client, self.reset_client, self.pause_client,
+                   self.odometry_reset]
         if self._planner:
             clients.append(self.climb_client)
         self.spin_until(lambda: (self.truth is not None and self.odom_count > 0
@@ -164,20 +170,27 @@ class SimSession:
         return future.result()
 
     def reset(self, x: float = 0.0, y: float = 0.0, yaw: float = 0.0) -> None:
-        """Robot back at rest at the pose, obstacles removed, odometry zeroed."""
+        """Robot back at rest at the pose, swivel at 0, obstacles removed, odometry zeroed."""
+        # The swivel to 0 first: the controller holds the angle a climb left it at and would
+        # turn the reset swivel back to it, moving the car.
+        self.drive_straight(0.0, 1.0)
         response = self.call(self.reset_client, ResetSimulation.Request(
             x=x, y=y, yaw=yaw, remove_obstacles=True))
         if not response.success:
             raise RuntimeError(f'sim reset failed: {response.message}')
+        self.settle(0.3)
         self.call(self.odometry_reset, Empty.Request())
-        # The controller may still hold the last climb's swivel angle and turns the reset
-        # swivel back to it, which moves the car a little: let that end first.
-        self.settle(2.0)
+        self.settle(0.2)
+
+    def set_paused(self, paused: bool) -> None:
+        response = self.call(self.pause_client, SetBool.Request(data=paused))
+        if not response.success:
+            raise RuntimeError(f'sim set_paused failed: {response.message}')
 
     def settle(self, seconds: float) -> None:
-        """Let ``seconds`` of wall time pass while spinning (the sim keeps stepping)."""
-        end = time.monotonic() + seconds
-        self.spin_until(lambda: time.monotonic() > end, seconds + 5.0, 'time to pass')
+        """Let ``seconds`` of sim time pass while spinning (the sim keeps stepping)."""
+        end = self.time + seconds
+        self.spin_until(lambda: self.time >= end, 60.0 + 10.0 * seconds, 'sim time to pass')
 
     def spawn_step(self, height: float, distance: float, yaw: float = 0.0,
                    depth: float = 2.0, width: float = 3.0, friction: float = 1.0) -> str:
@@ -196,14 +209,14 @@ class SimSession:
             timeout=CLIMB_WALL_LIMIT)
 
     def drive_straight(self, drive_speed: float, seconds: float) -> None:
-        """Hold the steering at 0 and drive for ``seconds`` of wall time, then stop. The
+        """Hold the steering at 0 and drive for ``seconds`` of sim time, then stop. The
         command is repeated within the controller's swivel_command deadman."""
         for speed, duration in ((drive_speed, seconds), (0.0, 0.5)):
-            end = time.monotonic() + duration
-            while time.monotonic() < end:
+            end = self.time + duration
+            while self.time < end:
                 self.swivel_command.publish(
                     SwivelCommand(angle=0.0, drive_speed=speed, hold=True))
-                self.settle(min(0.1, end - time.monotonic()))
+                self.settle(0.1)
         self.swivel_command.publish(SwivelCommand(hold=False))
 
     def front_on_top(self, height: float, tolerance: float = 0.015) -> bool:

@@ -68,3 +68,10 @@ def test_bad_construction_is_refused():
         InputSync(TOPICS, 'clock')
     with pytest.raises(ValueError, match='depth'):
         InputSync(TOPICS, 'controller', depth=0)
+
+
+def test_describe_names_each_topics_newest_stamp_and_the_waiting_tick():
+    sync = InputSync(TOPICS, 'controller')
+    feed(sync, [('controller', 1.0), ('imu', 1.0)])
+    assert sync.describe() == ('newest stamps: joint_states none, imu 1.00 s, odom none, '
+                               'controller 1.00 s; oldest waiting tick 1.00 s')

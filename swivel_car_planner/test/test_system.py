@@ -82,7 +82,12 @@ def test_second_goal_is_refused_and_cancel_stops_the_car_safely(stack):
     assert busy.error_code == ClimbStep.Response.ERROR_BUSY
     stack.spin_until(lambda: feedback[-1].phase >= Phase.ADVANCE, 120.0, 'the advance')
 
+    # Paused, so that the cancel lands while the wheel is up however fast the sim runs.
+    stack.set_paused(True)
+    assert feedback[-1].phase == Phase.ADVANCE
     cancel = handle.cancel_goal_async()
+    stack.spin_until(cancel.done, 30.0, 'the cancel response')
+    stack.set_paused(False)
     result = handle.get_result_async()
     stack.spin_until(result.done, 60.0, 'the canceled result')
     assert cancel.done()

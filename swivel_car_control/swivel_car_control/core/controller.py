@@ -48,9 +48,9 @@ class ControllerConfig:
         Deadman: a cmd_vel older than this stops the drive and holds the swivel; 0 disables.
         # [s]
     swivel_command_timeout : float
-        Deadman for the planner: a held swivel_command older than this is released (the drive
-        stops, the swivel holds, cmd_vel steers again); 0 disables. The planner repeats its
-        command every control cycle. # [s]
+        Deadman for the planner: a held swivel_command not renewed for this long is released
+        (the drive stops, the swivel holds, cmd_vel steers again); 0 disables. The planner
+        repeats its command every control cycle. # [s]
     slowdown_start, slowdown_stop : float
         Swivel error (target - measured) below which the drive runs at full speed, and above
         which it stops; cos(error) between. # [rad]
@@ -97,7 +97,7 @@ class SwivelCommandRequest:
     angle: float  # [rad]
     max_rate: float  # [rad/s], 0 = controller default
     drive_speed: float  # [rad/s] at the wheels
-    stamp: float  # [s] the command's time, for the deadman
+    stamp: float  # [s] when it was received, for the deadman
 
 
 @dataclass(frozen=True)
@@ -173,8 +173,8 @@ class SwivelController:
 
     def set_swivel_command(self, angle: float, max_rate: float, drive_speed: float,
                            hold: bool, stamp: float) -> None:
-        """Take the planner's direct command of time ``stamp`` [s]; ``hold=False`` releases
-        it to cmd_vel.
+        """Take the planner's direct command, received at ``stamp`` [s] (the deadman's
+        reference); ``hold=False`` releases it to cmd_vel.
 
         Raises
         ------

@@ -62,6 +62,13 @@ class InputSync:
             self._pending.append(stamp)
         return self._ready_ticks()
 
+    def describe(self) -> str:
+        """Each topic's newest stamp and the oldest waiting tick, for error messages."""
+        newest = ', '.join(f'{topic} {buffer[-1][0]:.2f} s' if buffer else f'{topic} none'
+                           for topic, buffer in self._buffers.items())
+        waiting = f'{self._pending[0]:.2f} s' if self._pending else 'none'
+        return f'newest stamps: {newest}; oldest waiting tick {waiting}'
+
     def clear(self) -> None:
         for buffer in self._buffers.values():
             buffer.clear()
