@@ -79,7 +79,7 @@ class ControllerNode(Node):
         self._core = SwivelController(car, config)
         self._swivel_joint = swivel_joint
         self._joints = JointReader([swivel_joint])
-        self._warned_zero_stamp: set[str] = set()
+        self._warned_zero_stamp = False
         self._last_time: float | None = None  # [s] stamp of the last joint_states answered
         self._heard_command_time = -math.inf  # [s] stamp of the last stamped swivel_command
         self._held_stamped = False  # the held swivel_command came stamped: it takes part in
@@ -105,37 +105,39 @@ class ControllerNode(Node):
             f'deadman {config.cmd_vel_timeout} s'
             + (', lockstep with swivel_command' if self._lockstep_swivel_command else ''))
 
-    def _command_time(self, stamp, topic: str, timeout: float) -> float:
-        """A command's stamp in seconds of the node clock; a zero stamp or one from another
+    def _now(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9  # [s]
+
+    def _cmd_vel_time(self, stamp) -> float:
+        """A cmd_vel stamp in seconds of the node clock; a zero stamp or one from another
         clock counts as now. # [s]"""
-        now = self.get_clock().now().nanoseconds * 1e-9
+        now = self._now()
         seconds = stamp_to_seconds(stamp)
         if is_zero_stamp(stamp):
-            if topic not in self._warned_zero_stamp:
+            if not self._warned_zero_stamp:
                 self.get_logger().warn(
-                    f'{topic} has a zero stamp: using the node clock (warned once)')
-                self._warned_zero_stamp.add(topic)
+                    'cmd_vel has a zero stamp: using the node clock (warned once)')
+                self._warned_zero_stamp = True
             return now
         if seconds > now + _CLOCK_SLACK:
             # A stamp from another clock (wall time against sim time) would never expire.
             self.get_logger().warn(
-                f'{topic} stamp is {seconds - now:.1f} s ahead of the node clock (clock '
+                f'cmd_vel stamp is {seconds - now:.1f} s ahead of the node clock (clock '
                 'mismatch? use_sim_time?): using the node clock', throttle_duration_sec=5.0)
             return now
-        if 0.0 < timeout < now - seconds:
+        if 0.0 < self._core.config.cmd_vel_timeout < now - seconds:
             self.get_logger().warn(
-                f'{topic} stamp is {now - seconds:.1f} s old, beyond its timeout: the deadman '
-                'ignores it (clock mismatch? use_sim_time?)', throttle_duration_sec=5.0)
+                f'cmd_vel stamp is {now - seconds:.1f} s old, beyond cmd_vel_timeout: the '
+                'deadman ignores it (clock mismatch? use_sim_time?)', throttle_duration_sec=5.0)
         return seconds
 
     def _on_cmd_vel(self, msg: TwistStamped | Twist) -> None:
         if isinstance(msg, TwistStamped):
             twist = msg.twist
-            stamp = self._command_time(msg.header.stamp, 'cmd_vel',
-                                       self._core.config.cmd_vel_timeout)
+            stamp = self._cmd_vel_time(msg.header.stamp)
         else:
             twist = msg
-            stamp = self.get_clock().now().nanoseconds * 1e-9
+            stamp = self._now()
         try:
             self._core.set_cmd_vel(twist.linear.x, twist.angular.z, stamp)
         except ValueError as error:
@@ -152,7 +154,7 @@ class ControllerNode(Node):
             # The deadman counts from receipt: a planner that lags behind a lockstep sim
             # running ahead of it (before its first command held the sim back) is not dead.
             self._core.set_swivel_command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold,
-                                          self.get_clock().now().nanoseconds * 1e-9)
+                                          self._now())
         except ValueError as error:
             self.get_logger().error(str(error), throttle_duration_sec=1.0)
         else:

@@ -29,6 +29,7 @@ def run(controller, t0, seconds, measured=None):
 
 def test_config_validation():
     for bad in ({'max_torque': 0.0}, {'cmd_vel_timeout': -1.0}, {'swivel_limit': math.nan},
+                {'swivel_command_timeout': -0.5}, {'swivel_command_timeout': math.inf},
                 {'slowdown_start': 0.5, 'slowdown_stop': 0.2}):
         with pytest.raises(ValueError):
             ControllerConfig(**bad)

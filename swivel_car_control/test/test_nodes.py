@@ -248,6 +248,17 @@ def test_lockstep_waits_for_the_planners_command_of_the_previous_state():
         harness.close()
 
 
+@pytest.mark.parametrize('wait', [0.0, -1.0, math.nan])
+def test_bad_lockstep_wait_is_a_clear_error_at_start(wait):
+    harness = None
+    try:
+        with pytest.raises(ValueError, match='lockstep_wait'):
+            harness = Harness(ControllerNode, {'lockstep_wait': wait})
+    finally:
+        rclpy.try_shutdown()
+    assert harness is None
+
+
 def test_plain_twist_parameter():
     harness = Harness(ControllerNode, {'use_stamped': False, 'cmd_vel_timeout': 0.0})
     try:

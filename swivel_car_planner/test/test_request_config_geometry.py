@@ -18,7 +18,8 @@ def test_default_config_is_valid():
 
 @pytest.mark.parametrize('name, value', [
     ('torque_limit', math.nan), ('clearance_margin', -0.01), ('swivel_rate', 0.0),
-    ('max_step_yaw', math.pi / 2), ('time_allowance', math.inf), ('stall_time', True)])
+    ('max_step_yaw', math.pi / 2), ('time_allowance', math.inf), ('stall_time', True),
+    ('stop_speed', 0.0), ('stop_speed', math.nan)])
 def test_bad_config_names_the_field(name, value):
     with pytest.raises(ValueError, match=name):
         PlannerConfig(**{name: value})
