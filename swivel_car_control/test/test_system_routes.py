@@ -30,6 +30,7 @@ from swivel_car_testing import (
 
 from swivel_car_control.benchmark import Segment, routes
 from swivel_car_control.gains import TUNED_GAINS
+from swivel_car_control.test.test_system import _seconds, _yaw
 
 SETTLE = 1.0  # [s] sim time standing still at the end of a route, as the benchmark
 # Our odometry's end-pose error, % of the distance travelled; the in-process benchmark
@@ -38,14 +39,6 @@ MAX_ERROR_PERCENT = 2.0
 # [m] The sweep at standstill moves base_link 8.7 cm (the swivel's reaction), too little to
 # divide by: typically 0.4 mm; one run in about ten gave 6 mm (unexplained, see the notes).
 MAX_STANDSTILL_ERROR = 0.01
-
-
-def _seconds(stamp) -> float:
-    return stamp.sec + 1e-9 * stamp.nanosec
-
-
-def _yaw(q) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
 class RouteDriver:
@@ -63,16 +56,16 @@ class RouteDriver:
         self.swivel = self.node.create_publisher(SwivelCommand, 'swivel_command', 10)
         self.node.create_subscription(
             Odometry, 'ground_truth/odom',
-            lambda m: self.truth.__setitem__(_seconds(m.header.stamp), m), 100)
+            lambda m: self.truth.__setitem__(_seconds(m), m), 100)
         self.node.create_subscription(
-            Odometry, 'odom', lambda m: self.odom.__setitem__(_seconds(m.header.stamp), m), 100)
+            Odometry, 'odom', lambda m: self.odom.__setitem__(_seconds(m), m), 100)
         self.node.create_subscription(SwivelControllerState, 'controller/controller_state',
                                       self._on_state, 100)
         self.reset_sim = self.node.create_client(ResetSimulation, 'sim/reset')
         self.reset_odometry = self.node.create_client(Empty, 'odometry/reset')
 
     def _on_state(self, msg: SwivelControllerState) -> None:
-        self.time = _seconds(msg.header.stamp)
+        self.time = _seconds(msg)
         while self.plan and self.time >= self.plan[0][0]:
             self.plan.pop(0)
             if not self.plan:
@@ -178,8 +171,8 @@ def test_route_odometry_against_ground_truth(driver, name):
     odom, truth, distance = driver.drive(ROUTES[name])
     error = math.hypot(odom.pose.pose.position.x - truth.pose.pose.position.x,
                        odom.pose.pose.position.y - truth.pose.pose.position.y)
-    heading = abs(math.remainder(_yaw(odom.pose.pose.orientation)
-                                 - _yaw(truth.pose.pose.orientation), 2.0 * math.pi))
+    heading = abs(math.remainder(_yaw(odom)
+                                 - _yaw(truth), 2.0 * math.pi))
     print(f'{name}: {distance:.3f} m travelled, odometry end error {error:.4f} m '
           f'({100.0 * error / max(distance, 1e-9):.2f} %), heading {heading:.4f} rad')
     if name == 'swivel_sweep_standstill':
