@@ -18,12 +18,12 @@ from dataclasses import dataclass
 
 import numpy as np
 from swivel_car_model import kinematics
+from swivel_car_model.description import CarDescription
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_model.planar import OffsetTricycleOdometry, arc_step, curvature_for_swivel
 from swivel_car_sim.physics import SimConfig, SwivelCarSim
 
 from swivel_car_control.core.controller import ControllerConfig, SwivelController
-from swivel_car_control.gains import TUNED_GAINS
 
 CONTROL_PERIOD = 0.01  # [s], as the sim node's default
 SWIVEL, REAR_LEFT, REAR_RIGHT = 0, 1, 2  # joint order of SwivelCarSim.state()
@@ -107,19 +107,18 @@ class ClosedLoop:
 
     Parameters
     ----------
-    p : SwivelCarParams
-        Geometry (the gains are replaced by the tuned ones unless ``gains`` is given).
+    description : CarDescription
+        The robot (default: the stack's).
     config : ControllerConfig
     """
 
-    def __init__(self, p: SwivelCarParams | None = None,
-                 config: ControllerConfig | None = None,
-                 gains: dict[str, float] | None = None) -> None:
-        base = p or SwivelCarParams()
-        self.p = SwivelCarParams(**{**base.__dict__, **(gains or TUNED_GAINS)})
+    def __init__(self, description: CarDescription | None = None,
+                 config: ControllerConfig | None = None) -> None:
+        description = description or CarDescription()
+        self.p = description.model_params()
         self.config = config or ControllerConfig(cmd_vel_timeout=0.0,
                                                    swivel_command_timeout=0.0)
-        self.sim = SwivelCarSim(SimConfig(params=self.p))
+        self.sim = SwivelCarSim(SimConfig(description=description))
         self.steps_per_period = round(CONTROL_PERIOD / self.sim.config.time_step)
         self.controller = SwivelController(self.p, self.config)
         self.odometry = OffsetTricycleOdometry(self.p)
@@ -188,8 +187,8 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--routes', default='', help='comma-separated subset of the routes')
     args = parser.parse_args(argv)
-    p = SwivelCarParams(**{**SwivelCarParams().__dict__, **TUNED_GAINS})
-    chosen = routes(p)
+    description = CarDescription()
+    chosen = routes(description.model_params())
     if args.routes:
         chosen = {name: chosen[name] for name in args.routes.split(',')}
     print('end-pose error vs ground truth: position as % of the distance travelled, heading '
@@ -199,7 +198,7 @@ def main(argv: list[str] | None = None) -> None:
     print(f'{"route":25s} {"dist m":>7s} {"turn rad":>8s} | {"ours %":>7s} {"yaw":>6s} | '
           f'{"rear yaw %":>10s} {"yaw":>6s} | {"plain %":>7s} {"yaw":>6s} | wall s')
     for name, segments in chosen.items():
-        loop = ClosedLoop(p)
+        loop = ClosedLoop(description)
         wall = time.monotonic()
         try:
             result = loop.drive(name, segments)

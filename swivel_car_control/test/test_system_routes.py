@@ -22,14 +22,13 @@ from nav_msgs.msg import Odometry
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from std_srvs.srv import Empty
-from swivel_car_model.params import SwivelCarParams
+from swivel_car_model.description import CarDescription
 from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ResetSimulation
 from swivel_car_testing import (
     lockstep_parameters, next_domain_id, spin_until, start_node)
 
 from swivel_car_control.benchmark import Segment, routes
-from swivel_car_control.gains import TUNED_GAINS
 from swivel_car_control.test.test_system import _seconds, _yaw
 
 SETTLE = 1.0  # [s] sim time standing still at the end of a route, as the benchmark
@@ -162,7 +161,7 @@ def driver():
     assert all(code == 0 for code in codes.values()), codes
 
 
-P = SwivelCarParams(**{**SwivelCarParams().__dict__, **TUNED_GAINS})
+P = CarDescription().model_params()
 ROUTES = routes(P)
 
 

@@ -6,12 +6,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from swivel_car_model.params import SwivelCarParams
+from swivel_car_model import description
 from swivel_car_sim.physics import SimConfig
 
-_DEFAULT_GEOMETRY = SwivelCarParams()
-
-# name -> (default, description). The node declares exactly these.
+# name -> (default, description). The node declares exactly these: its own, then the robot
+# description's (swivel_car_model.description, shared by every node).
 PARAMETERS: dict[str, tuple[object, str]] = {
     'gui': (False, 'open the pybullet GUI window (needs a display)'),
     'time_step': (0.002, '[s] physics step'),
@@ -29,22 +28,14 @@ PARAMETERS: dict[str, tuple[object, str]] = {
     'watchdog_timeout': (0.5, '[s] sim time without a command after which the swivel torque '
                               'is zeroed and the drive stops; 0 disables'),
     'robot_variant': ('swivel', "'swivel' or 'car_like' (baseline with a steered front axle)"),
-    'l': (_DEFAULT_GEOMETRY.l, '[m] length of each T column'),
-    'h': (_DEFAULT_GEOMETRY.h, '[m] half wheel shaft: wheel plane to column'),
-    'phi': (_DEFAULT_GEOMETRY.phi, '[rad] angle between the T columns (thesis phi)'),
-    'r': (_DEFAULT_GEOMETRY.r, '[m] wheel radius'),
-    'mass': (_DEFAULT_GEOMETRY.mass, '[kg] total mass'),
     'initial_x': (0.0, '[m] initial base_link x in the world'),
     'initial_y': (0.0, '[m] initial base_link y in the world'),
     'initial_yaw': (0.0, '[rad] initial heading'),
     'start_paused': (False, 'start with the physics paused (~/set_paused false resumes)'),
     'imu_rate': (100.0, '[Hz] imu publish rate; control_period divided by a whole number'),
     'ground_truth_rate': (100.0, '[Hz] ground_truth/odom publish rate; as imu_rate'),
-    'swivel_torque_limit': (40.0, '[N m] largest |swivel torque| applied'),
-    'drive_torque_limit': (10.0, '[N m] largest |total drive torque at the wheels|'),
-    'drive_speed_limit': (20.0, '[rad/s] largest |drive speed at the wheels|'),
     'ground_friction': (1.0, '[1] friction coefficient of the ground'),
-    'wheel_friction': (1.0, '[1] friction coefficient of the tyres'),
+    **description.PARAMETERS,
 }
 
 
@@ -91,13 +82,12 @@ class SimNodeConfig:
                 v[name] = float(value)
             elif not isinstance(value, str):
                 raise ValueError(f'{name} must be a string, got {value!r}')
-        geometry = SwivelCarParams(l=v['l'], h=v['h'], phi=v['phi'], r=v['r'], mass=v['mass'])
+        robot = description.CarDescription.from_values(
+            {name: v[name] for name in description.PARAMETERS})
         physics = SimConfig(
-            params=geometry, robot_variant=v['robot_variant'], time_step=v['time_step'],
-            gui=v['gui'], swivel_torque_limit=v['swivel_torque_limit'],
-            drive_torque_limit=v['drive_torque_limit'],
-            drive_speed_limit=v['drive_speed_limit'], watchdog_timeout=v['watchdog_timeout'],
-            ground_friction=v['ground_friction'], wheel_friction=v['wheel_friction'])
+            description=robot, robot_variant=v['robot_variant'], time_step=v['time_step'],
+            gui=v['gui'], watchdog_timeout=v['watchdog_timeout'],
+            ground_friction=v['ground_friction'])
         steps = _whole_ratio(v['control_period'], physics.time_step, 'control_period',
                              'time_step')
         if v['real_time_factor'] < 0.0:

@@ -4,7 +4,7 @@ ROS-free. ``SwivelCarSim`` owns one pybullet client (DIRECT unless ``gui``), ste
 fixed ``time_step`` and exposes what a motor driver board and an IMU would: joint states, base
 orientation, angular velocity and specific force, plus the ground truth pose and twist.
 
-Drive train (one motor, an open differential per axle, front and rear carriers coupled rigidly).
+Drive train (one motor, a differential per axle, front and rear carriers coupled rigidly).
 pybullet's gear constraints couple two joints, not the three bodies of a differential, so the
 torques are computed every physics step and applied with TORQUE_CONTROL:
 
@@ -15,8 +15,11 @@ torques are computed every physics step and applied with TORQUE_CONTROL:
   0.002 s step cannot be): a torsional spring-damper between the rear and front carrier angles,
   ``T_f = K_s (theta_r - theta_f) + K_d (omega_r - omega_f)``, so the carrier speeds stay equal
   on average and the wind-up stays small (about 0.06 rad at 10 N m);
-* each differential is open: both wheels of an axle get half the axle's torque (front
-  ``T_f``, rear ``T_m - T_f``), their speeds free to differ.
+* an open differential gives both wheels of its axle half the axle's torque (front ``T_f``,
+  rear ``T_m - T_f``), their speeds free to differ; a locked one adds the same kind of
+  spring-damper between its two wheel angles, ``T_c = K_w (theta_a - theta_b) + D_w (omega_a
+  - omega_b)`` taken from wheel a and given to wheel b, so a wheel that loses its grip cannot
+  spin away while the other one stands (the torque goes where the traction is).
 
 The gains follow from the wheel inertia and the time step so that the worst case, an axle with
 both wheels in the air, is still well damped; their values are in ``DriveGains``.
@@ -32,8 +35,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet
 
+from swivel_car_model.description import CarDescription, ROBOT_VARIANTS
 from swivel_car_model.params import SwivelCarParams
-from swivel_car_sim.urdf import build_robot, RobotDescription, ROBOT_VARIANTS
+from swivel_car_sim.urdf import build_robot, RobotModel
 
 GRAVITY = 9.81  # [m/s^2]
 MAX_STEPS_PER_CALL = 100_000
@@ -49,47 +53,41 @@ class SimConfig:
 
     Parameters
     ----------
-    params : SwivelCarParams
-        Robot geometry and masses.
+    description : CarDescription
+        The robot: geometry, mass layout, drive train, actuator limits, tyre friction.
     robot_variant : str
         'swivel' or 'car_like'.
     time_step : float
         Physics step. # [s]
     gui : bool
         Open the pybullet GUI (needs a display) instead of DIRECT.
-    swivel_torque_limit : float
-        Largest |swivel torque| applied. # [N m]
-    drive_torque_limit : float
-        Largest |total drive torque at the wheels|. # [N m]
-    drive_speed_limit : float
-        Largest |drive speed at the wheels|. # [rad/s]
     watchdog_timeout : float
         Sim time without a command after which the swivel torque is zeroed and the drive
         commanded to stop; 0 disables the watchdog. # [s]
-    ground_friction, wheel_friction : float
-        Coulomb friction coefficients (pybullet combines them by product). # [1]
+    ground_friction : float
+        Coulomb friction coefficient of the ground (pybullet multiplies it with the tyres'
+        ``description.wheel_friction``). # [1]
     """
 
-    params: SwivelCarParams = field(default_factory=SwivelCarParams)
+    description: CarDescription = field(default_factory=CarDescription)
     robot_variant: str = 'swivel'
     time_step: float = 0.002  # [s]
     gui: bool = False
-    swivel_torque_limit: float = 40.0  # [N m]
-    drive_torque_limit: float = 10.0  # [N m]
-    drive_speed_limit: float = 20.0  # [rad/s]
     watchdog_timeout: float = 0.5  # [s]
     ground_friction: float = 1.0  # [1]
-    wheel_friction: float = 1.0  # [1]
 
     def __post_init__(self) -> None:
         if self.robot_variant not in ROBOT_VARIANTS:
             raise ValueError(
                 f'robot_variant must be one of {ROBOT_VARIANTS}, got {self.robot_variant!r}')
         _require(0.0 < self.time_step <= 0.01, 'time_step', self.time_step, 'in (0, 0.01] s')
-        for name in ('swivel_torque_limit', 'drive_torque_limit', 'drive_speed_limit',
-                     'ground_friction', 'wheel_friction'):
-            _require(getattr(self, name) > 0.0, name, getattr(self, name), '> 0')
+        _require(self.ground_friction > 0.0, 'ground_friction', self.ground_friction, '> 0')
         _require(self.watchdog_timeout >= 0.0, 'watchdog_timeout', self.watchdog_timeout, '>= 0')
+
+    @property
+    def params(self) -> SwivelCarParams:
+        """The model's parameter set of the robot (geometry, derived mass and inertia)."""
+        return self.description.model_params()
 
 
 def _require(ok: bool, name: str, value, what: str) -> None:
@@ -107,12 +105,16 @@ class DriveGains:
     speed_i : float  # [N m/rad]
     shaft_stiffness : float  # [N m/rad]
     shaft_damping : float  # [N m s/rad]
+    lock_stiffness : float  # [N m/rad] between the wheels of a locked axle
+    lock_damping : float  # [N m s/rad]
     """
 
     speed_p: float
     speed_i: float
     shaft_stiffness: float
     shaft_damping: float
+    lock_stiffness: float
+    lock_damping: float
 
     @classmethod
     def for_robot(cls, params: SwivelCarParams, time_step: float) -> 'DriveGains':
@@ -126,7 +128,12 @@ class DriveGains:
         speed_i = (speed_p / (2.0 * 0.7)) ** 2 / loaded_carrier
         stiffness = 0.25 * free_carrier / time_step ** 2
         damping = 2.0 * 0.7 * math.sqrt(stiffness * free_carrier)
-        return cls(speed_p, speed_i, stiffness, damping)
+        # The two wheels of an axle twist against each other with the reduced inertia
+        # I_w / 2 (free in the air, the worst case): the same stiffness per time step.
+        relative = wheel_inertia / 2.0
+        lock_stiffness = 0.25 * relative / time_step ** 2
+        lock_damping = 2.0 * 0.7 * math.sqrt(lock_stiffness * relative)
+        return cls(speed_p, speed_i, stiffness, damping, lock_stiffness, lock_damping)
 
 
 @dataclass(frozen=True)
@@ -221,8 +228,12 @@ class SwivelCarSim:
     def __init__(self, config: SimConfig | None = None,
                  initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None:
         self.config = config or SimConfig()
-        self.robot: RobotDescription = build_robot(self.config.params, self.config.robot_variant)
-        self.gains = DriveGains.for_robot(self.config.params, self.config.time_step)
+        self.description = self.config.description
+        self.params = self.config.params
+        self.robot: RobotModel = build_robot(self.description, self.config.robot_variant)
+        self.gains = DriveGains.for_robot(self.params, self.config.time_step)
+        self._rear_locked = self.description.rear_differential == 'locked'
+        self._front_locked = self.description.front_differential == 'locked'
         self._client = pybullet.connect(pybullet.GUI if self.config.gui else pybullet.DIRECT)
         if self._client < 0:
             raise RuntimeError('pybullet could not connect' + (' a GUI (is there a display?)'
@@ -281,10 +292,10 @@ class SwivelCarSim:
         for name, value in (('swivel_torque', swivel_torque), ('drive_speed', drive_speed)):
             if not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise ValueError(f'{name} must be finite, got {value!r}')
-        c = self.config
-        self._swivel_torque = min(c.swivel_torque_limit, max(-c.swivel_torque_limit,
+        d = self.description
+        self._swivel_torque = min(d.swivel_torque_limit, max(-d.swivel_torque_limit,
                                                               float(swivel_torque)))
-        self._drive_speed = min(c.drive_speed_limit, max(-c.drive_speed_limit,
+        self._drive_speed = min(d.drive_speed_limit, max(-d.drive_speed_limit,
                                                           float(drive_speed)))
         self._command_time = self.time
 
@@ -320,7 +331,7 @@ class SwivelCarSim:
             swivel_torque, drive_speed = self._swivel_torque, self._drive_speed
         rear_speed, front_speed = (rl[1] + rr[1]) / 2.0, (fl[1] + fr[1]) / 2.0
         error = drive_speed - rear_speed
-        limit = self.config.drive_torque_limit
+        limit = self.description.drive_torque_limit
         unsaturated = g.speed_p * error + g.speed_i * (self._speed_integral + error * dt)
         motor = min(limit, max(-limit, unsaturated))
         if motor == unsaturated:
@@ -328,7 +339,12 @@ class SwivelCarSim:
         front = (g.shaft_stiffness * ((rl[0] + rr[0]) - (fl[0] + fr[0])) / 2.0
                  + g.shaft_damping * (rear_speed - front_speed))
         rear = motor - front
-        self._efforts = [swivel_torque, rear / 2.0, rear / 2.0, front / 2.0, front / 2.0]
+        rear_lock = (g.lock_stiffness * (rl[0] - rr[0]) + g.lock_damping * (rl[1] - rr[1])
+                     if self._rear_locked else 0.0)
+        front_lock = (g.lock_stiffness * (fl[0] - fr[0]) + g.lock_damping * (fl[1] - fr[1])
+                      if self._front_locked else 0.0)
+        self._efforts = [swivel_torque, rear / 2.0 - rear_lock, rear / 2.0 + rear_lock,
+                         front / 2.0 - front_lock, front / 2.0 + front_lock]
         pybullet.setJointMotorControlArray(self._body, self._joint_ids, pybullet.TORQUE_CONTROL,
                                            forces=self._efforts, physicsClientId=self._client)
 
@@ -359,7 +375,7 @@ class SwivelCarSim:
     def _load_robot(self, x: float, y: float, yaw: float) -> None:
         pb = self._pb
         orientation = pybullet.getQuaternionFromEuler([0.0, 0.0, yaw])
-        self._body = pb.loadURDF(self._urdf_path, [x, y, self.config.params.r], orientation,
+        self._body = pb.loadURDF(self._urdf_path, [x, y, self.params.r], orientation,
                                  flags=URDF_FLAGS)
         names = {pb.getJointInfo(self._body, i)[1].decode(): i
                  for i in range(pb.getNumJoints(self._body))}
@@ -370,7 +386,7 @@ class SwivelCarSim:
         pb.setJointMotorControlArray(self._body, self._joint_ids, pybullet.VELOCITY_CONTROL,
                                      forces=[0.0] * len(self._joint_ids))
         for link in range(-1, pb.getNumJoints(self._body)):
-            pb.changeDynamics(self._body, link, lateralFriction=self.config.wheel_friction,
+            pb.changeDynamics(self._body, link, lateralFriction=self.description.wheel_friction,
                               linearDamping=0.0, angularDamping=0.0, jointDamping=0.0)
         inertial = pb.getDynamicsInfo(self._body, -1)
         self._com_in_link = (inertial[3], inertial[4])
@@ -424,7 +440,7 @@ class SwivelCarSim:
             # Lowest rim point: centre minus r times the unit vector of -z orthogonal to axis.
             down = np.array([0.0, 0.0, -1.0]) - axis * -axis[2]
             norm = np.linalg.norm(down)
-            heights.append(s[4][2] + (self.config.params.r * down[2] / norm if norm > 1e-9
+            heights.append(s[4][2] + (self.params.r * down[2] / norm if norm > 1e-9
                                       else 0.0))
         return np.array(heights)
 
@@ -508,7 +524,7 @@ class SwivelCarSim:
         base_pos, base_orn = self._base_pose()
         rotation = np.array(pybullet.getMatrixFromQuaternion(base_orn)).reshape(3, 3)
         heading = math.atan2(rotation[1, 0], rotation[0, 0])
-        contact = base_pos + rotation @ self.config.params.front_axle
+        contact = base_pos + rotation @ self.params.front_axle
         direction = np.array([math.cos(heading), math.sin(heading), 0.0])
         normal_yaw = heading + spec.yaw
         normal = np.array([math.cos(normal_yaw), math.sin(normal_yaw), 0.0])
@@ -522,7 +538,7 @@ class SwivelCarSim:
         if not self._obstacles:
             return []
         pb = self._pb
-        probe = pb.loadURDF(self._urdf_path, [x, y, self.config.params.r],
+        probe = pb.loadURDF(self._urdf_path, [x, y, self.params.r],
                             pybullet.getQuaternionFromEuler([0.0, 0.0, yaw]), flags=URDF_FLAGS)
         try:
             return [name for name, body in self._obstacles.items()

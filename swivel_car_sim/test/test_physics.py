@@ -6,6 +6,7 @@ import numpy as np
 import pybullet
 import pytest
 from swivel_car_model import dynamics, kinematics, planar
+from swivel_car_model.description import CarDescription
 from swivel_car_model.params import SwivelCarParams
 
 from swivel_car_sim.physics import SimConfig, StepSpec, SwivelCarSim
@@ -35,8 +36,9 @@ def test_driving_straight_speed_is_wheel_speed_times_r(sim):
 
 def _sweep(phi: float) -> dict:
     """Swivel 0 -> SWEEP_END at standstill (drive held at 0), logging every period."""
-    p = SwivelCarParams(phi=phi)
-    with SwivelCarSim(SimConfig(params=p)) as s:
+    d = CarDescription(phi=phi)
+    p = d.model_params()
+    with SwivelCarSim(SimConfig(description=d)) as s:
         hold = SwivelHold(s)
         hold.run(50, 0.0, 0.0)
         start = s.state()
@@ -120,8 +122,9 @@ def test_free_rolling_sweep_turns_like_the_dae(phi):
     # pose change. It puts the body mass at the apex' ground projection, the sim's centre of
     # mass sits at 24 % of the wheelbase (to match I_s), and free wheels let the mass layout
     # steer the translation; so only the turn is compared, within 0.1 rad.
-    p = SwivelCarParams(phi=phi)
-    with SwivelCarSim(SimConfig(params=p, drive_torque_limit=1e-9)) as s:
+    d = CarDescription(phi=phi, drive_torque_limit=1e-9)
+    p = d.model_params()
+    with SwivelCarSim(SimConfig(description=d)) as s:
         hold = SwivelHold(s)
         hold.run(50, 0.0, 0.0)
         start = s.state()
@@ -215,7 +218,7 @@ def test_non_finite_command_is_refused_and_the_previous_one_stays(sim):
 def test_commands_are_clamped_to_the_limits(sim):
     sim.set_command(1000.0, 0.0)
     sim.step(1)
-    assert sim.state().efforts[0] == sim.config.swivel_torque_limit
+    assert sim.state().efforts[0] == sim.description.swivel_torque_limit
 
 
 STEP = dict(name='', height=0.1, depth=0.5, width=1.0, distance=0.2, yaw=0.0, friction=0.1)
@@ -301,7 +304,7 @@ def test_bad_reset_is_refused_and_changes_nothing(sim):
 
 @pytest.mark.parametrize('change, message', [
     (dict(time_step=0.0), 'time_step'), (dict(time_step=math.nan), 'time_step'),
-    (dict(drive_torque_limit=-1.0), 'drive_torque_limit'),
+    (dict(ground_friction=-1.0), 'ground_friction'),
     (dict(watchdog_timeout=-0.1), 'watchdog_timeout'),
     (dict(robot_variant='boat'), 'robot_variant')])
 def test_bad_config_is_refused(change, message):
@@ -370,3 +373,30 @@ def test_show_state_places_the_robot_and_render_draws_it(sim):
     assert image.shape == (48, 64, 3) and image.dtype == np.uint8
     # The robot is in view: the picture is not one flat colour.
     assert image.reshape(-1, 3).std(axis=0).max() > 10.0
+
+
+def _one_rear_wheel_on_ice(rear_differential: str) -> tuple[float, float, float]:
+    """Drive 1 s with every tyre but the rear right one on ice (friction 0.01): (distance
+    [m], rear left and rear right wheel rates [rad/s])."""
+    description = CarDescription(rear_differential=rear_differential,
+                                 front_differential='open')
+    with SwivelCarSim(SimConfig(description=description)) as s:
+        for wheel in (s._wheel_ids[0], s._wheel_ids[2], s._wheel_ids[3]):
+            pybullet.changeDynamics(s._body, wheel, lateralFriction=0.01,
+                                    physicsClientId=s._client)
+        hold = SwivelHold(s)
+        hold.run(100, 0.0, 6.0)
+        state = s.state()
+    return float(state.position[0]), float(state.velocities[1]), float(state.velocities[2])
+
+
+def test_a_locked_rear_differential_drives_the_wheel_that_grips():
+    open_distance, open_left, open_right = _one_rear_wheel_on_ice('open')
+    locked_distance, locked_left, locked_right = _one_rear_wheel_on_ice('locked')
+    print(f'open: {open_distance:.3f} m, rear wheels {open_left:.2f} / {open_right:.2f} rad/s; '
+          f'locked: {locked_distance:.3f} m, {locked_left:.2f} / {locked_right:.2f} rad/s')
+    # Open: the torque of both rear wheels is what the icy one can take; it spins faster.
+    assert open_left > open_right + 1.0
+    # Locked: both turn together and the car goes further on the gripping wheel.
+    assert locked_left == pytest.approx(locked_right, abs=0.1)
+    assert locked_distance > open_distance + 0.05

@@ -5,43 +5,66 @@ from pathlib import Path
 import numpy as np
 import pybullet
 import pytest
-from swivel_car_model.params import SwivelCarParams
+from swivel_car_model.description import CarDescription
 
 from swivel_car_sim.urdf import build_robot, default_urdf_path, ROBOT_VARIANTS, WHEEL_JOINTS
 
 URDF_DIR = Path(__file__).resolve().parents[1] / 'urdf'
 
-DESIGNS = [SwivelCarParams(), SwivelCarParams(phi=-math.pi / 3),
-           SwivelCarParams(l=0.4, h=0.1, r=0.05), SwivelCarParams(h=0.25, r=0.1, phi=0.3)]
+DESIGNS = [CarDescription(), CarDescription(phi=-math.pi / 3),
+           CarDescription(l=0.4, h=0.1, r=0.05), CarDescription(h=0.25, r=0.1, phi=0.3),
+           CarDescription(body_mass=12.0, body_offset=0.05, rear_axle_mass=3.0)]
 
 
 @pytest.mark.parametrize('variant', ROBOT_VARIANTS)
 def test_committed_default_urdf_matches_generator(variant):
     assert (URDF_DIR / default_urdf_path(variant)).read_text() == \
-        build_robot(SwivelCarParams(), variant).urdf, \
+        build_robot(CarDescription(), variant).urdf, \
         'regenerate: python -m swivel_car_sim.urdf --out swivel_car_sim/urdf'
 
 
+@pytest.mark.parametrize('description', DESIGNS)
 @pytest.mark.parametrize('variant', ROBOT_VARIANTS)
-def test_table2_mass_and_inertia(variant):
-    robot = build_robot(SwivelCarParams(), variant)
+def test_urdf_carries_the_description_masses(description, variant):
+    robot = build_robot(description, variant)
     masses = [float(m.get('value')) for m in ET.fromstring(robot.urdf).iter('mass')]
-    assert sum(masses) == pytest.approx(21.0, rel=1e-9)
-    assert robot.mass == pytest.approx(21.0, rel=1e-9)
-    assert robot.inertia_about_rear_axle == pytest.approx(0.84, rel=1e-6)
+    assert sum(masses) == pytest.approx(description.mass, rel=1e-9)
+    assert robot.mass == pytest.approx(description.mass, rel=1e-9)
+    if variant == 'swivel':
+        assert robot.inertia_about_rear_axle == pytest.approx(
+            description.inertia_about_rear_axle, rel=1e-12)
+        np.testing.assert_allclose(robot.com, description.com, atol=1e-12)
 
 
-def test_inertia_out_of_reach_is_clamped_and_reported():
-    # A long car cannot reach 0.84 kg m^2: its front axle alone carries more.
-    robot = build_robot(SwivelCarParams(l=0.4, h=0.1, r=0.05))
-    assert robot.mass == pytest.approx(21.0)
-    assert robot.inertia_about_rear_axle > 0.84 * 1.5
-
-
-@pytest.mark.parametrize('params', DESIGNS)
 @pytest.mark.parametrize('variant', ROBOT_VARIANTS)
-def test_designs_load_in_pybullet_with_the_contract_joints(params, variant, tmp_path):
-    robot = build_robot(params, variant)
+def test_urdf_inertials_give_the_description_centre_of_mass_in_pybullet(variant, tmp_path):
+    description = CarDescription(body_mass=10.0, body_offset=0.04)
+    robot = build_robot(description, variant)
+    path = tmp_path / 'robot.urdf'
+    path.write_text(robot.urdf)
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        body = pybullet.loadURDF(str(path), flags=pybullet.URDF_USE_INERTIA_FROM_FILE,
+                                 physicsClientId=client)
+        total, moment = 0.0, np.zeros(3)
+        for link in range(-1, pybullet.getNumJoints(body, physicsClientId=client)):
+            mass = pybullet.getDynamicsInfo(body, link, physicsClientId=client)[0]
+            position = (pybullet.getBasePositionAndOrientation(body, physicsClientId=client)[0]
+                        if link < 0 else
+                        pybullet.getLinkState(body, link, physicsClientId=client)[0])
+            total += mass
+            moment += mass * np.array(position)
+    finally:
+        pybullet.disconnect(client)
+    assert total == pytest.approx(description.mass)
+    np.testing.assert_allclose(moment / total, robot.com, atol=1e-9)
+
+
+@pytest.mark.parametrize('description', DESIGNS)
+@pytest.mark.parametrize('variant', ROBOT_VARIANTS)
+def test_designs_load_in_pybullet_with_the_contract_joints(description, variant, tmp_path):
+    robot = build_robot(description, variant)
+    params = description.model_params()
     path = tmp_path / 'robot.urdf'
     path.write_text(robot.urdf)
     client = pybullet.connect(pybullet.DIRECT)
@@ -66,8 +89,9 @@ def test_designs_load_in_pybullet_with_the_contract_joints(params, variant, tmp_
 
 
 def test_wheels_sit_where_the_params_say():
-    p = SwivelCarParams(phi=-0.8, l=0.3, h=0.12)
-    root = ET.fromstring(build_robot(p).urdf)
+    d = CarDescription(phi=-0.8, l=0.3, h=0.12)
+    p = d.model_params()
+    root = ET.fromstring(build_robot(d).urdf)
     origins = {j.get('name'): np.array(j.find('origin').get('xyz').split(), dtype=float)
                for j in root.iter('joint')}
     np.testing.assert_allclose(origins['swivel_joint'], p.apex, atol=1e-8)
@@ -78,4 +102,4 @@ def test_wheels_sit_where_the_params_say():
 
 def test_unknown_variant_is_refused():
     with pytest.raises(ValueError, match='robot_variant'):
-        build_robot(SwivelCarParams(), 'tank')
+        build_robot(CarDescription(), 'tank')
