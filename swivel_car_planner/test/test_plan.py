@@ -8,24 +8,26 @@ import pytest
 from swivel_car_model import climbing, dynamics, kinematics
 from swivel_car_model.params import SwivelCarParams
 
-from swivel_car_planner.core import ClimbRequest, ErrorCode, PlanError, PlannerConfig, make_plan
+from swivel_car_planner.core import (
+    ClimbRequest, ErrorCode, make_plan, PlanError, PlannerConfig, validate_request)
 from swivel_car_planner.core.plan import (
     lead_angle, PROCEDURE_ACTIVE_LIFT, PROCEDURE_SEMI_ACTIVE)
 
 P = SwivelCarParams()
 CONFIG = PlannerConfig()
-# The planner without the rear axle's traction limit: the model's own limits only.
-FRONT = dataclasses.replace(CONFIG, rear_step_limit=1.0)
+# make_plan without a whole-car limit checks the model's own limits only.
+FRONT = CONFIG
+WHOLE_CAR_LIMIT = 0.08  # [m]
 
 
-def request(height=0.05, distance=1.2, yaw=0.0, plan_only=False):
+def request(height=0.05, distance=1.2, yaw=0.0, plan_only=False, width=0.0, offset=0.0):
     return ClimbRequest(step_height=height, step_distance=distance, step_yaw=yaw,
-                        plan_only=plan_only)
+                        plan_only=plan_only, step_width=width, step_offset=offset)
 
 
-def refusal(p=P, config=CONFIG, **kwargs):
+def refusal(p=P, config=CONFIG, whole_car_limit=math.inf, **kwargs):
     with pytest.raises(PlanError) as caught:
-        make_plan(p, config, request(**kwargs))
+        make_plan(p, config, request(**kwargs), whole_car_limit)
     return caught.value
 
 
@@ -77,11 +79,20 @@ def test_second_wheel_swivel_lifts_it_by_the_clearance_on_the_other_side():
         CONFIG.clearance_margin)
 
 
-def test_step_above_the_rear_axle_limit_is_unreachable_for_the_whole_car():
-    error = refusal(height=CONFIG.rear_step_limit + 0.01)
+def test_step_above_the_measured_whole_car_limit_is_refused_with_the_limit():
+    error = refusal(height=WHOLE_CAR_LIMIT + 0.01, whole_car_limit=WHOLE_CAR_LIMIT)
     assert error.code == ErrorCode.UNREACHABLE_HEIGHT
-    assert 'rear axle' in error.message
-    assert make_plan(P, FRONT, request(CONFIG.rear_step_limit + 0.01)).swivel_angle > 0.0
+    assert 'whole car' in error.message and f'{WHOLE_CAR_LIMIT:.3f} m' in error.message
+    assert make_plan(P, CONFIG, request(WHOLE_CAR_LIMIT), WHOLE_CAR_LIMIT).swivel_angle > 0.0
+    assert make_plan(P, FRONT, request(WHOLE_CAR_LIMIT + 0.01)).swivel_angle > 0.0
+
+
+def test_plan_only_makes_exactly_the_checks_of_a_real_call():
+    for kwargs in (dict(height=WHOLE_CAR_LIMIT + 0.01), dict(distance=0.1),
+                   dict(width=0.3)):
+        real = refusal(whole_car_limit=WHOLE_CAR_LIMIT, **kwargs)
+        planned = refusal(whole_car_limit=WHOLE_CAR_LIMIT, plan_only=True, **kwargs)
+        assert (planned.code, planned.message) == (real.code, real.message)
 
 
 def test_approach_accounts_for_the_drift_of_the_lift():
@@ -122,11 +133,49 @@ def test_wheel_interference_refuses_a_long_shaft_on_a_short_body():
     assert 'eq. 75' in error.message
 
 
-def test_step_too_close_to_align_is_invalid_unless_plan_only():
+def test_step_too_close_to_align_is_invalid():
     error = refusal(config=FRONT, height=0.05, distance=0.1)
     assert error.code == ErrorCode.INVALID_REQUEST
     assert 'too close' in error.message
-    assert make_plan(P, FRONT, request(0.05, distance=0.1, plan_only=True)).swivel_angle > 0.0
+
+
+def test_without_a_width_the_approach_only_holds_its_heading():
+    assert make_plan(P, CONFIG, request(0.05)).crossing is None
+
+
+@pytest.mark.parametrize('yaw, offset', [(0.0, -0.6), (0.3, -0.6), (-0.3, 0.6), (0.0, -1.0)])
+def test_the_crossing_keeps_every_wheel_on_the_top_face(yaw, offset):
+    width = 1.5
+    plan = make_plan(P, CONFIG, request(0.05, distance=2.5, yaw=yaw, width=width,
+                                        offset=offset))
+    psi = plan.lead_angle
+    # The wheels' contacts while on top, from the rear axle at the crossing to the front
+    # axle once the trailing rear wheel is rest_margin past the edge.
+    reach = (CONFIG.rest_margin + P.h * abs(math.sin(psi))) / math.cos(psi) + P.wheelbase
+    for along_heading in (0.0, reach):
+        for side in (-1.0, 1.0):
+            along = (plan.crossing + along_heading * math.sin(psi)
+                     + side * (P.h * math.cos(psi) + P.wheel_width / 2.0))
+            assert offset - width / 2.0 + CONFIG.edge_margin - 1e-9 <= along
+            assert along <= offset + width / 2.0 - CONFIG.edge_margin + 1e-9
+
+
+def test_a_face_the_approach_cannot_reach_is_refused_as_too_close():
+    error = refusal(height=0.05, distance=1.0, width=1.5)
+    assert error.code == ErrorCode.INVALID_REQUEST
+    assert 'sideways' in error.message
+
+
+def test_a_face_narrower_than_the_car_needs_is_refused():
+    error = refusal(height=0.05, width=0.45)
+    assert error.code == ErrorCode.INVALID_REQUEST
+    assert 'too narrow' in error.message
+
+
+def test_bad_extent_is_an_invalid_request():
+    assert validate_request(request(width=-1.0), CONFIG)[0] == ErrorCode.INVALID_REQUEST
+    assert validate_request(request(offset=math.nan), CONFIG)[0] == ErrorCode.INVALID_REQUEST
+    assert validate_request(request(offset=99.0), CONFIG)[0] == ErrorCode.INVALID_REQUEST
 
 
 @settings(max_examples=30, deadline=None)

@@ -252,3 +252,19 @@ def test_a_car_asked_while_moving_first_stops_holding_its_swivel():
     assert machine.step == Step.APPROACH and approach.drive_speed > 0.0
     run(machine, car)
     assert machine.outcome.success, machine.outcome.message
+
+
+@pytest.mark.parametrize('yaw, offset', [(0.1, -0.5), (-0.1, 0.5), (0.0, -0.3)])
+def test_with_the_step_extent_the_approach_reaches_the_planned_crossing(yaw, offset):
+    request = ClimbRequest(0.04, 2.0, yaw, step_width=1.5, step_offset=offset)
+    plan = make_plan(P, CONFIG, request)
+    machine = ClimbStateMachine(P, CONFIG, plan, 2.0, yaw)
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.phase == Phase.LIFT)
+    edge = StepEdge.from_request(Pose2D(0.0, 0.0, 0.0), P.wheelbase, 2.0, yaw)
+    # base_link on the planned line: through the crossing at the approach heading.
+    heading = plan.approach_heading
+    normal = edge.signed_distance(car.odometry.x, car.odometry.y)
+    along = edge.along(car.odometry.x, car.odometry.y) - plan.crossing
+    assert abs(-math.sin(heading) * normal + math.cos(heading) * along) < 0.03
+    assert machine.phase == Phase.LIFT

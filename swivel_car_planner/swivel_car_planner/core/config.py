@@ -53,9 +53,12 @@ class PlannerConfig:
     rear_slip_allowance: float = _field(
         0.25, 'odometry past the edge beyond rest_margin with the car still pitched: the '
         'rear axle failed to climb [m]')
-    rear_step_limit: float = _field(
-        0.04, 'highest step the rear axle climbs by traction (measured in the sim); higher '
-        'steps are refused as unreachable for the whole car [m]')
+    edge_margin: float = _field(
+        0.05, 'every wheel on top stays this far inside the sides of the step\'s top face '
+        '(when the request gives its width) [m]')
+    crossing_gain: float = _field(
+        4.0, 'approach: heading correction per metre of the centre line off its planned '
+        'crossing of the edge [rad/m]')
     rest_margin: float = _field(
         0.05, 'rear wheel contacts past the edge to call the climb done [m]')
     level_tolerance: float = _field(

@@ -59,6 +59,12 @@ class StepEdge:
         return ((x - self.px) * math.cos(self.normal_yaw)
                 + (y - self.py) * math.sin(self.normal_yaw))
 
+    def along(self, x: float, y: float) -> float:
+        """Where the point (x, y) lies along the edge, leftwards (normal turned +90 deg)
+        from the edge's point. # [m]"""
+        return (-(x - self.px) * math.sin(self.normal_yaw)
+                + (y - self.py) * math.cos(self.normal_yaw))
+
     def relative_heading(self, yaw: float) -> float:
         """The car's heading relative to the normal, positive = turned left. # [rad]"""
         return wrap_angle(yaw - self.normal_yaw)

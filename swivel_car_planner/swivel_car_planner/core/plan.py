@@ -80,6 +80,10 @@ class ClimbPlan:
     lead_distance: float  # [m] lifted wheel's contact to the edge (along the normal) at lift
     second_swivel_angle: float  # [rad] swivel that holds the second wheel clearance_margin up
     step_height: float  # [m]
+    # [m] where the car's centre line crosses the edge, along the edge (leftwards) from the
+    # point the request's x axis meets it; None: the step's extent is not known, the approach
+    # only holds its heading
+    crossing: float | None = None
 
 
 def lead_angle(p: SwivelCarParams, config: PlannerConfig, step_height: float) -> float:
@@ -102,14 +106,104 @@ def lead_angle(p: SwivelCarParams, config: PlannerConfig, step_height: float) ->
     return math.asin(sine)
 
 
-def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest) -> ClimbPlan:
-    """Check feasibility and plan the climb of a validated request.
+def crossing_range(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
+                   heading: float) -> tuple[float, float]:
+    """Where along the edge the car's centre line may cross it so that every wheel that is on
+    the step stays on its top face, ``edge_margin`` inside its sides, while the car drives on
+    at ``heading`` (to the normal) until the trailing rear wheel is ``rest_margin`` past the
+    edge. Along the edge leftwards from where the request's x axis meets it; empty (low >
+    high) when the face is too narrow. # [m]"""
+    sine, cosine = math.sin(heading), math.cos(heading)
+    # Along the heading from the crossing, the wheels on top lie between the rear axle at
+    # the crossing and the front axle once the trailing rear wheel is rest_margin past.
+    reach = (config.rest_margin + p.h * abs(sine)) / cosine + p.wheelbase  # [m]
+    half = p.h * cosine + p.wheel_width / 2.0 + config.edge_margin
+    low = request.step_offset - request.step_width / 2.0 + half - min(0.0, sine * reach)
+    high = request.step_offset + request.step_width / 2.0 - half - max(0.0, sine * reach)
+    return low, high
+
+
+@dataclass(frozen=True)
+class _Approach:
+    """How the car meets the edge when it lifts the wheel on ``side``."""
+
+    side: int  # +1: left front wheel lifted
+    lead: float  # [rad] heading to the normal once the wheel is up
+    heading: float  # [rad] heading to the normal when the lift starts
+    lead_distance: float  # [m] lifted wheel's contact to the edge at lift
+    axle_normal: float  # [m] front axle centre to the edge at lift, along the normal
+    crossing: float | None  # [m] see ClimbPlan.crossing
+    shift: float  # [m] sideways move the approach must make to reach the crossing
+    error: str | None  # why this approach cannot be made
+
+
+def _approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
+              theta2: float, side: int) -> _Approach:
+    height = request.step_height
+    # Never below the model's minimum approach angle (thesis eqs. 92-100, exact wheel discs;
+    # the bound the thesis derives for phi < 0, and a check of the derivation above).
+    psi_lead = -side * max(lead_angle(p, config, height),
+                           float(climbing.min_approach_angle_for_step(p, height)))
+    drift_x, drift_y, drift_yaw = (
+        float(v) for v in dynamics.swivel_pose_drift(p, 0.0, side * abs(theta2)))
+    heading = psi_lead - drift_yaw
+    drift_normal = drift_x * math.cos(heading) - drift_y * math.sin(heading)
+    lead_distance = p.r + config.lift_gap + max(0.0, drift_normal)
+    axle_normal = lead_distance + p.h * abs(math.sin(heading))
+
+    # Aligning turns on an arc of radius >= wheelbase / tan(max_steer); give it room.
+    turn_radius = p.wheelbase / math.tan(config.max_steer)
+    align_run = 1.5 * turn_radius * abs(math.sin(heading) + math.sin(request.step_yaw))
+    available = request.step_distance * math.cos(request.step_yaw)
+    error = None
+    if available < axle_normal + align_run:
+        error = (f'the step is too close: aligning to {heading:.2f} rad and lifting needs '
+                 f'the edge at least {axle_normal + align_run:.2f} m ahead of the front axle '
+                 f'(along its normal), it is {available:.2f} m')
+    crossing, shift = None, 0.0
+    if request.step_width > 0.0:
+        low, high = crossing_range(p, config, request, psi_lead)
+        # The line through base_link at the approach heading, as the car stands now, meets
+        # the edge at ``natural``; the approach follows that line moved to the face.
+        back = p.wheelbase + request.step_distance  # [m] base_link to the edge along x
+        natural = back * (math.sin(request.step_yaw)
+                          + math.cos(request.step_yaw) * math.tan(heading))
+        crossing = min(high, max(low, natural))
+        shift = abs(crossing - natural)
+        # Past the turns (align_run), the car may head up to max_steer nearer the normal
+        # than the approach heading: that moves its crossing by this much at most.
+        straight = max(0.0, available - axle_normal - align_run)
+        room = straight * (math.tan(abs(heading))
+                           - math.tan(max(0.0, abs(heading) - config.max_steer)))
+        if low > high:
+            shift = math.inf
+            error = (f'the step\'s top face ({request.step_width:.2f} m wide) is too narrow: '
+                     f'crossing at {psi_lead:.2f} rad to the edge\'s normal the car needs '
+                     f'{request.step_width + high - low:.2f} m to keep every wheel on it')
+        elif shift > room and error is None:
+            error = (f'the step is too close: reaching the top face means moving '
+                     f'{shift:.2f} m sideways, the approach has room for {room:.2f} m')
+    return _Approach(side, psi_lead, heading, lead_distance, axle_normal, crossing, shift,
+                     error)
+
+
+def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
+              whole_car_limit: float = math.inf) -> ClimbPlan:
+    """Check feasibility and plan the climb of a validated request; ``plan_only`` requests
+    get exactly the same checks.
+
+    Parameters
+    ----------
+    whole_car_limit : float
+        Highest step the whole car climbs reliably (``capability.CapabilityTable.limit``);
+        higher ones are refused. # [m]
 
     Raises
     ------
     PlanError
         With ``UNREACHABLE_HEIGHT``, ``TIP_OVER``, ``WHEEL_INTERFERENCE``, ``TORQUE_LIMIT``
-        or ``INVALID_REQUEST`` (the step is too close to align) and a message.
+        or ``INVALID_REQUEST`` (the step is too close to align, or its top face too narrow
+        for the car) and a message.
     """
     height = request.step_height
     max_step, _ = kinematics.max_scalable_step(p, respect_tip_over=True)
@@ -140,38 +234,27 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest) 
         raise PlanError(ErrorCode.TORQUE_LIMIT,
                         f'the climb needs a peak swivel torque of {peak_torque:.2f} N m, above '
                         f'the actuator limit of {config.torque_limit:.2f} N m')
-    if height > config.rear_step_limit:
+    if height > whole_car_limit:
         raise PlanError(ErrorCode.UNREACHABLE_HEIGHT,
-                        f'the front wheels could lift over {height:.3f} m, but the rear axle '
-                        f'has no lift mechanism and climbs only {config.rear_step_limit:.3f} m '
-                        f'by traction (parameter rear_step_limit)')
+                        f'the front wheels could lift over {height:.3f} m, but the whole car '
+                        f'climbs reliably only up to {whole_car_limit:.3f} m (the rear axle '
+                        f'climbs by traction; measured in the sim, the capability table)')
 
-    # Lift the wheel on the side that leads already, so the car turns the least.
+    # Lift the wheel on the side that leads already, so the car turns the least; with the
+    # step's extent known, on the side whose natural crossing of the edge lies nearer the
+    # top face.
     initial_heading = -request.step_yaw  # [rad] car heading to the edge's normal
-    side = 1 if initial_heading <= 0.0 else -1
-    # Never below the model's minimum approach angle (thesis eqs. 92-100, exact wheel discs;
-    # the bound the thesis derives for phi < 0, and a check of the derivation above).
-    psi_lead = -side * max(lead_angle(p, config, height),
-                           float(climbing.min_approach_angle_for_step(p, height)))
-    signed_theta2 = side * abs(theta2)
-    drift_x, drift_y, drift_yaw = (
-        float(v) for v in dynamics.swivel_pose_drift(p, 0.0, signed_theta2))
-    approach_heading = psi_lead - drift_yaw
-    drift_normal = (drift_x * math.cos(approach_heading)
-                    - drift_y * math.sin(approach_heading))
-    lead_distance = p.r + config.lift_gap + max(0.0, drift_normal)
-    axle_normal = lead_distance + p.h * abs(math.sin(approach_heading))
-    approach_distance = axle_normal / math.cos(approach_heading)
-
-    # Aligning turns on an arc of radius >= wheelbase / tan(max_steer); give it room.
-    turn_radius = p.wheelbase / math.tan(config.max_steer)
-    align_run = 1.5 * turn_radius * abs(math.sin(approach_heading) - math.sin(initial_heading))
+    leading = 1 if initial_heading <= 0.0 else -1
+    sides = (leading, -leading) if request.step_width > 0.0 else (leading,)
+    approaches = [_approach(p, config, request, theta2, side) for side in sides]
+    approach = min(approaches, key=lambda a: (a.error is not None, a.shift, a.side != leading))
+    if approach.error is not None:
+        raise PlanError(ErrorCode.INVALID_REQUEST, approach.error)
     available = request.step_distance * math.cos(request.step_yaw)
-    if not request.plan_only and available < axle_normal + align_run:
-        raise PlanError(ErrorCode.INVALID_REQUEST,
-                        f'the step is too close: aligning to {approach_heading:.2f} rad and '
-                        f'lifting needs the edge at least {axle_normal + align_run:.2f} m '
-                        f'ahead of the front axle (along its normal), it is {available:.2f} m')
+    side, psi_lead, approach_heading = approach.side, approach.lead, approach.heading
+    lead_distance, axle_normal = approach.lead_distance, approach.axle_normal
+    approach_distance = axle_normal / math.cos(approach_heading)
+    signed_theta2 = side * abs(theta2)
 
     v_approach = config.approach_speed * p.r  # [m/s]
     v_climb = config.climb_speed * p.r  # [m/s]
@@ -191,4 +274,4 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest) 
         lifted_side=side, lead_angle=psi_lead, lead_distance=lead_distance,
         second_swivel_angle=-side * float(kinematics.swivel_for_step(
             p, config.clearance_margin, respect_tip_over=False)),
-        step_height=height)
+        step_height=height, crossing=approach.crossing)

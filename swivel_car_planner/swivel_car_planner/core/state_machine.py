@@ -244,7 +244,7 @@ class ClimbStateMachine:
                         f'reached the lift point {error:.2f} rad off the planned heading '
                         f'(tolerance {config.align_tolerance:.2f} rad)')
                 return self._enter(Step.LIFT, obs)
-            return self._steer(obs, plan.approach_heading, config.approach_speed)
+            return self._steer(obs, self._approach_heading(obs), config.approach_speed)
         if step == Step.LIFT:
             if self._settled(obs, plan.swivel_angle):
                 return self._enter(Step.ADVANCE, obs)
@@ -289,6 +289,21 @@ class ClimbStateMachine:
                 f'puts it {rear:.2f} m past the edge while the pitch is still {obs.pitch:.3f} '
                 f'rad (the rear wheels slip; they climb by traction only)')
         return self._steer(obs, plan.lead_angle, config.rear_speed)
+
+    def _approach_heading(self, obs: Observation) -> float:
+        """The planned approach heading, corrected towards the planned crossing of the edge
+        when the step's extent is known (a line through the crossing at that heading). # [rad]
+        """
+        plan = self._plan
+        if plan.crossing is None:
+            return plan.approach_heading
+        normal = self._edge.signed_distance(obs.x, obs.y)
+        along = self._edge.along(obs.x, obs.y) - plan.crossing
+        heading = plan.approach_heading
+        off_line = -math.sin(heading) * normal + math.cos(heading) * along  # [m] left of it
+        correction = self._config.crossing_gain * off_line
+        limit = self._config.max_steer
+        return heading - min(limit, max(-limit, correction))
 
     def _steer(self, obs: Observation, heading: float, drive_speed: float) -> Command:
         """Drive at ``drive_speed`` steering towards ``heading`` (to the edge normal)."""
