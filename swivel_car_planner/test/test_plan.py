@@ -161,9 +161,9 @@ def test_the_crossing_keeps_every_wheel_on_the_top_face(yaw, offset):
 
 
 def test_a_face_the_approach_cannot_reach_is_refused_as_too_close():
-    error = refusal(height=0.05, distance=1.0, width=1.5)
+    error = refusal(height=0.05, distance=1.0, width=1.5, offset=2.5)
     assert error.code == ErrorCode.INVALID_REQUEST
-    assert 'sideways' in error.message
+    assert 'beside the top face' in error.message
 
 
 def test_a_face_narrower_than_the_car_needs_is_refused():

@@ -152,7 +152,7 @@ def _approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
     axle_normal = lead_distance + p.h * abs(math.sin(heading))
 
     # Aligning turns on an arc of radius >= wheelbase / tan(max_steer); give it room.
-    turn_radius = p.wheelbase / math.tan(config.max_steer)
+    turn_radius = p.wheelbase / math.tan(config.max_steer)  # [m]
     align_run = 1.5 * turn_radius * abs(math.sin(heading) + math.sin(request.step_yaw))
     available = request.step_distance * math.cos(request.step_yaw)
     error = None
@@ -163,26 +163,35 @@ def _approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
     crossing, shift = None, 0.0
     if request.step_width > 0.0:
         low, high = crossing_range(p, config, request, psi_lead)
-        # The line through base_link at the approach heading, as the car stands now, meets
-        # the edge at ``natural``; the approach follows that line moved to the face.
+        # Where base_link's line crosses the edge: turning to the approach heading at once
+        # gives ``now``; holding today's heading until the last turn and lift gives ``late``;
+        # any crossing between is reachable by choosing when to turn.
         back = p.wheelbase + request.step_distance  # [m] base_link to the edge along x
-        natural = back * (math.sin(request.step_yaw)
-                          + math.cos(request.step_yaw) * math.tan(heading))
-        crossing = min(high, max(low, natural))
-        shift = abs(crossing - natural)
-        # Past the turns (align_run), the car may head up to max_steer nearer the normal
-        # than the approach heading: that moves its crossing by this much at most.
-        straight = max(0.0, available - axle_normal - align_run)
-        room = straight * (math.tan(abs(heading))
-                           - math.tan(max(0.0, abs(heading) - config.max_steer)))
+        along, normal = back * math.sin(request.step_yaw), back * math.cos(request.step_yaw)
+        initial = -request.step_yaw  # [rad] heading to the normal now
+        now = along + normal * math.tan(heading)
+        # Late: straight on, one arc of radius turn_radius to the approach heading, then
+        # straight at it from the lift point (base_link ``final`` before the edge) on.
+        arc = turn_radius * abs(math.sin(heading) - math.sin(initial))  # [m] along normal
+        final = axle_normal + p.wheelbase * math.cos(heading)  # [m]
+        late = (along + max(0.0, normal - arc - final) * math.tan(initial)
+                + math.copysign(turn_radius * abs(math.cos(initial) - math.cos(heading)),
+                                heading - initial)
+                + min(normal, final) * math.tan(heading))
+        reachable = (min(now, late), max(now, late))
+        crossing = min(high, max(low, now))
+        nearest = min(reachable[1], max(reachable[0], crossing))
+        shift = abs(crossing - nearest)
+        room = reachable[1] - reachable[0]
         if low > high:
             shift = math.inf
             error = (f'the step\'s top face ({request.step_width:.2f} m wide) is too narrow: '
                      f'crossing at {psi_lead:.2f} rad to the edge\'s normal the car needs '
                      f'{request.step_width + high - low:.2f} m to keep every wheel on it')
-        elif shift > room and error is None:
-            error = (f'the step is too close: reaching the top face means moving '
-                     f'{shift:.2f} m sideways, the approach has room for {room:.2f} m')
+        elif shift > 1e-9 and error is None:
+            error = (f'the step is too close: the car would cross the edge {shift:.2f} m '
+                     f'beside the top face; the approach can move its crossing by '
+                     f'{room:.2f} m')
     return _Approach(side, psi_lead, heading, lead_distance, axle_normal, crossing, shift,
                      error)
 
