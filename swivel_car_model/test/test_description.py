@@ -57,3 +57,21 @@ def test_every_field_is_a_parameter_with_a_unit():
     for name, (default, description) in PARAMETERS.items():
         assert getattr(CarDescription(), name) == default
         assert description.endswith(']') or isinstance(default, str), name
+
+
+def test_the_shipped_designs_are_valid_descriptions():
+    from pathlib import Path
+
+    import yaml
+    designs = sorted((Path(__file__).resolve().parents[1] / 'config' / 'designs').glob('*.yaml'))
+    assert designs
+    for path in designs:
+        values = yaml.safe_load(path.read_text())['/**']['ros__parameters']
+        description = CarDescription.from_values(values)
+        assert description.mass == pytest.approx(21.0), path.name
+
+
+def test_the_forward_body_design_has_the_measured_layout():
+    d = CarDescription(body_mass=14.0, body_offset=0.05, rear_axle_mass=1.2)
+    assert d.com_fraction == pytest.approx(0.594, abs=1e-3)
+    assert d.inertia_about_rear_axle == pytest.approx(1.908, abs=1e-3)
