@@ -7,6 +7,7 @@ swivel_car_sim package from the tests. Importing the real packages first prevent
 lets same-named test files (test_system.py) live in several packages.
 """
 
+import swivel_car_bringup  # noqa: F401
 import swivel_car_control  # noqa: F401
 import swivel_car_model  # noqa: F401
 import swivel_car_planner  # noqa: F401

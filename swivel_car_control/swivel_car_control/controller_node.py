@@ -17,8 +17,9 @@ from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelController
 
 from swivel_car_control.conversions import is_zero_stamp, stamp_to_seconds
 from swivel_car_control.core.controller import ControllerConfig, SwivelController
+from swivel_car_control.core.joint_states import JointStateController
 from swivel_car_control.gains import TUNED_GAINS
-from swivel_car_control.joints import JointReader, MissingJointError
+from swivel_car_control.joints import MissingJointError
 from swivel_car_control.ros_params import (
     declare_car_params, declare_dataclass, refuse_runtime_changes, run_node)
 
@@ -77,10 +78,8 @@ class ControllerNode(Node):
                                | {'use_stamped', 'swivel_joint', 'lockstep_swivel_command',
                                   'lockstep_wait'})
         self._core = SwivelController(car, config)
-        self._swivel_joint = swivel_joint
-        self._joints = JointReader([swivel_joint])
+        self._joint_states = JointStateController(self._core, swivel_joint)
         self._warned_zero_stamp = False
-        self._last_time: float | None = None  # [s] stamp of the last joint_states answered
         self._heard_command_time = -math.inf  # [s] stamp of the last stamped swivel_command
         self._held_stamped = False  # the held swivel_command came stamped: it takes part in
         # the lockstep
@@ -171,11 +170,11 @@ class ControllerNode(Node):
     def _must_wait(self, msg: JointState) -> bool:
         """Lockstep with a stamped swivel_command held: ``msg`` waits for the command that
         answers the previous joint_states (the planner's pipeline is one cycle deep)."""
-        if (not self._lockstep_swivel_command or self._planner_late or self._last_time is None
+        last_time = self._joint_states.last_time  # [s] of the last joint_states answered
+        if (not self._lockstep_swivel_command or self._planner_late or last_time is None
                 or self._core.swivel_command is None or not self._held_stamped):
             return False
-        return (stamp_to_seconds(msg.header.stamp) > self._last_time
-                > self._heard_command_time)
+        return stamp_to_seconds(msg.header.stamp) > last_time > self._heard_command_time
 
     def _take_pending(self) -> JointState:
         msg, self._pending = self._pending, None
@@ -205,19 +204,14 @@ class ControllerNode(Node):
         t = stamp_to_seconds(msg.header.stamp)
         command = ActuatorCommand()
         command.header.stamp = msg.header.stamp
-        if self._last_time is not None and t < self._last_time:
-            self._joints.reset()
         try:
-            swivel = self._joints.read(t, msg.name, msg.position, msg.velocity)[
-                self._swivel_joint]
+            swivel, out = self._joint_states.answer(t, msg.name, msg.position, msg.velocity)
         except MissingJointError as error:
             # Still answer the stamp (the lockstep sim waits for it), with the safe command.
             self.get_logger().warn(f'{error}: commanding zero torque and drive',
                                    throttle_duration_sec=5.0)
             self._command_pub.publish(command)
             return
-        self._last_time = t
-        out = self._core.step(t, swivel.position, swivel.rate)
         if out.cmd_vel_timed_out:
             self.get_logger().info('cmd_vel timed out: drive stopped, swivel held',
                                    throttle_duration_sec=10.0)

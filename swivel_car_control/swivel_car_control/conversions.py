@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import math
-
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Quaternion
+
+from swivel_car_control.core.joint_states import yaw_quaternion
 
 
 def stamp_to_seconds(stamp: Time) -> float:
@@ -19,4 +19,5 @@ def is_zero_stamp(stamp: Time) -> bool:
 
 def yaw_to_quaternion(yaw: float) -> Quaternion:
     """Rotation about z by ``yaw`` [rad]."""
-    return Quaternion(x=0.0, y=0.0, z=math.sin(0.5 * yaw), w=math.cos(0.5 * yaw))
+    x, y, z, w = yaw_quaternion(yaw)
+    return Quaternion(x=x, y=y, z=z, w=w)

@@ -13,19 +13,13 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Empty
-from swivel_car_model.planar import OffsetTricycleOdometry
 from swivel_car_msgs.srv import SetPose2D
 
 from swivel_car_control.conversions import stamp_to_seconds, yaw_to_quaternion
-from swivel_car_control.joints import JointReader, MissingJointError
+from swivel_car_control.core.joint_states import JointStateOdometry, YAW_RATE_SOURCES
+from swivel_car_control.joints import MissingJointError
 from swivel_car_control.ros_params import (
     declare_car_params, declare_dataclass, refuse_runtime_changes, run_node)
-
-# 'swivel': the offset tricycle's steering constraint (thesis II.E); 'rear_wheels': the yaw
-# rate from the rear wheels' rate difference (the speed from the model in both cases).
-YAW_RATE_SOURCES = ('swivel', 'rear_wheels')
-# A swivel reading this far past the joint limit (compliance, sensor noise) is clamped to it.
-_LIMIT_SLACK = 0.05  # [rad]
 
 
 @dataclass(frozen=True)
@@ -103,11 +97,10 @@ class OdometryNode(Node):
         self._config = config = declare_dataclass(self, OdometryConfig, CONFIG_DESCRIPTIONS)
         refuse_runtime_changes(self, {f.name for f in dataclasses.fields(self._car)}
                                | {f.name for f in dataclasses.fields(config)})
-        self._odometry = OffsetTricycleOdometry(self._car)
-        self._joints = JointReader([config.swivel_joint, config.rear_left_wheel_joint,
-                                    config.rear_right_wheel_joint])
-        self._last_time: float | None = None  # [s] of the last joint_states used
-        self._next_publish: float | None = None  # [s] joint_states time of the next odom
+        self._joint_odometry = JointStateOdometry(
+            self._car, config.swivel_joint, config.rear_left_wheel_joint,
+            config.rear_right_wheel_joint, config.yaw_rate_source, config.publish_rate)
+        self._odometry = self._joint_odometry.odometry
         self._tf = self._make_tf_broadcaster() if config.enable_odom_tf else None
 
         self._pose_covariance = _diagonal(config.pose_covariance_diagonal)
@@ -131,38 +124,21 @@ class OdometryNode(Node):
 
     def _on_joint_states(self, msg: JointState) -> None:
         t = stamp_to_seconds(msg.header.stamp)
-        if self._last_time is not None and t < self._last_time:
+        last_time = self._joint_odometry.last_time
+        if last_time is not None and t < last_time:
             self.get_logger().info('time jumped back (sim reset?): restarting the integration, '
                                    'pose kept')
-            self._joints.reset()
-            self._last_time = None
-            self._next_publish = None
         try:
-            joints = self._joints.read(t, msg.name, msg.position, msg.velocity)
+            due = self._joint_odometry.update(t, msg.name, msg.position, msg.velocity)
         except MissingJointError as error:
             self.get_logger().warn(f'{error}: odometry not updated', throttle_duration_sec=5.0)
             return
-        c = self._config
-        swivel = joints[c.swivel_joint]
-        limit = self._car.max_swivel_angle
-        theta2 = swivel.position
-        if abs(theta2) <= limit + _LIMIT_SLACK:
-            theta2 = max(-limit, min(limit, theta2))
-        left, right = joints[c.rear_left_wheel_joint].rate, joints[c.rear_right_wheel_joint].rate
-        difference = right - left if c.yaw_rate_source == 'rear_wheels' else None
-        dt = 0.0 if self._last_time is None else t - self._last_time
-        try:
-            self._odometry.update(theta2, swivel.rate, 0.5 * (left + right), dt, difference)
         except ValueError as error:
             self.get_logger().warn(f'odometry not updated: {error}', throttle_duration_sec=5.0)
             return
-        self._last_time = t
         # Published on joint_states time, not a timer: in a lockstep sim every run publishes
         # the same poses, and a consumer can wait for the odom of a given state.
-        period = 1.0 / c.publish_rate
-        if self._next_publish is None or t >= self._next_publish - 1e-9:
-            due = (t if self._next_publish is None else self._next_publish) + period
-            self._next_publish = due if due > t else t + period
+        if due:
             self._publish(msg.header.stamp)
 
     def _publish(self, stamp) -> None:

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-
 from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan as ClimbPlanMsg
 
 from swivel_car_planner.core import ClimbPlan, ClimbRequest, Outcome
@@ -33,14 +31,3 @@ def outcome_to_msg(outcome: Outcome) -> ClimbOutcome:
         energy=float(outcome.energy), max_pitch=float(outcome.max_pitch),
         distance_travelled=float(outcome.distance_travelled))
 
-
-def roll_pitch(x: float, y: float, z: float, w: float) -> tuple[float, float]:
-    """Roll and pitch of a quaternion (REP-103 fixed-axis roll, pitch, yaw). # [rad]"""
-    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-    return roll, pitch
-
-
-def yaw_of(x: float, y: float, z: float, w: float) -> float:
-    """Yaw of a quaternion. # [rad]"""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))

@@ -31,15 +31,15 @@ from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
 
-from swivel_car_planner.conversions import (
-    outcome_to_msg, plan_to_msg, request_from, roll_pitch, yaw_of)
+from swivel_car_planner.conversions import outcome_to_msg, plan_to_msg, request_from
 from swivel_car_planner.core import (
-    ClimbRequest, ClimbStateMachine, Command, ErrorCode, Observation, PlanError,
+    ClimbRequest, ClimbStateMachine, Command, ErrorCode, PlanError,
     PlannerConfig, make_plan, validate_request)
+from swivel_car_planner.core import inputs
 from swivel_car_planner.core.sync import InputSync, Tick
 
-_CONTROLLER_STATE = 'controller/controller_state'
-_INPUTS = ('joint_states', 'imu', 'odom', _CONTROLLER_STATE)
+_CONTROLLER_STATE = inputs.CONTROLLER_STATE
+_INPUTS = inputs.INPUTS
 
 _ROBOT_DESCRIPTIONS = {
     'l': 'length of each T column [m]', 'h': 'half-length of each wheel shaft [m]',
@@ -141,24 +141,23 @@ class PlannerNode(Node):
 
     def _on_odom(self, msg: Odometry) -> None:
         q = msg.pose.pose.orientation
-        self._add('odom', msg, (msg.pose.pose.position.x, msg.pose.pose.position.y,
-                                yaw_of(q.x, q.y, q.z, q.w), msg.twist.twist.linear.x))
+        self._add(inputs.ODOM, msg, inputs.odom_values(
+            msg.pose.pose.position.x, msg.pose.pose.position.y, (q.x, q.y, q.z, q.w),
+            msg.twist.twist.linear.x))
 
     def _on_joint_states(self, msg: JointState) -> None:
-        if self._swivel_joint not in msg.name:
-            return
-        index = msg.name.index(self._swivel_joint)
-        if index >= len(msg.position):
-            return
-        rate = msg.velocity[index] if index < len(msg.velocity) else 0.0
-        self._add('joint_states', msg, (float(msg.position[index]), float(rate)))
+        values = inputs.joint_state_values(self._swivel_joint, msg.name, msg.position,
+                                           msg.velocity)
+        if values is not None:
+            self._add(inputs.JOINT_STATES, msg, values)
 
     def _on_imu(self, msg: Imu) -> None:
         q = msg.orientation
-        self._add('imu', msg, (*roll_pitch(q.x, q.y, q.z, q.w), yaw_of(q.x, q.y, q.z, q.w)))
+        self._add(inputs.IMU, msg, inputs.imu_values((q.x, q.y, q.z, q.w)))
 
     def _on_controller_state(self, msg: SwivelControllerState) -> None:
-        self._add(_CONTROLLER_STATE, msg, (msg.set_point, msg.torque))
+        self._add(_CONTROLLER_STATE, msg, inputs.controller_state_values(msg.set_point,
+                                                                          msg.torque))
 
     def _add(self, topic: str, msg, value: tuple) -> None:
         self._received[topic] = self._now()
@@ -172,17 +171,6 @@ class PlannerNode(Node):
         return [topic for topic in _INPUTS
                 if now <= 0.0 or topic not in self._received
                 or now - self._received[topic] > self._ready_timeout]
-
-    @staticmethod
-    def _observation(tick: Tick) -> Observation:
-        x, y, yaw, speed = tick.values['odom']
-        swivel, swivel_rate = tick.values['joint_states']
-        roll, pitch, imu_yaw = tick.values['imu']
-        set_point, torque = tick.values[_CONTROLLER_STATE]
-        return Observation(
-            time=tick.time, x=x, y=y, yaw=yaw, swivel=swivel, swivel_rate=swivel_rate,
-            set_point=set_point, torque=torque, roll=roll, pitch=pitch, imu_yaw=imu_yaw,
-            speed=speed)
 
     # --- the climb ------------------------------------------------------------------------
 
@@ -237,7 +225,7 @@ class PlannerNode(Node):
         self._quiet_checks = 0
         if climb.goal_handle is not None and climb.goal_handle.is_cancel_requested:
             climb.machine.cancel()
-        command = climb.machine.update(self._observation(tick))
+        command = climb.machine.update(inputs.observation(tick))
         self._publish_command(command, tick.time)
         if climb.goal_handle is not None:
             climb.goal_handle.publish_feedback(self._feedback_msg(climb.machine.feedback))
@@ -270,8 +258,8 @@ class PlannerNode(Node):
         """After a failure the swivel holds where it is (the last command) and is released:
         the controller keeps holding it, and cmd_vel steers again."""
         self._climb = None
-        if not climb.machine.outcome.success:
-            self._publish_command(Command(0.0, 0.0, 0.0, False), stamp)
+        for command in inputs.end_commands(climb.machine.outcome):
+            self._publish_command(command, stamp)
         climb.done.set_result(climb.machine.outcome)
 
     def _publish_command(self, command: Command, stamp: float) -> None:

@@ -8,8 +8,6 @@ ground truth. Processes come from the repository's scripts/swivel_car_stack.py.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-import math
 import os
 from pathlib import Path
 import sys
@@ -34,38 +32,10 @@ except ImportError:  # outside pytest: the repository's helpers (pytest.ini puts
     from swivel_car_testing import next_domain_id, spin_until
 from swivel_car_stack import NodeProcess, lockstep_parameters, start_node
 
+from swivel_car_planner.ground_truth import GroundTruth  # noqa: F401  (re-exported)
+
 CLIMB_WALL_LIMIT = 600.0  # [s] guard against a hung stack, not a measurement
 LOCKSTEP_TIMEOUT = 2.0  # [s] wall
-
-
-@dataclass(frozen=True)
-class GroundTruth:
-    """The sim's ground_truth/odom, base_link in the world frame."""
-
-    x: float  # [m]
-    y: float  # [m]
-    z: float  # [m]
-    roll: float  # [rad]
-    pitch: float  # [rad]
-    yaw: float  # [rad]
-    speed: float  # [m/s] |linear velocity|
-
-    @classmethod
-    def from_msg(cls, msg: Odometry) -> GroundTruth:
-        q = msg.pose.pose.orientation
-        roll = math.atan2(2.0 * (q.w * q.x + q.y * q.z), 1.0 - 2.0 * (q.x * q.x + q.y * q.y))
-        pitch = math.asin(max(-1.0, min(1.0, 2.0 * (q.w * q.y - q.z * q.x))))
-        yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-        v = msg.twist.twist.linear
-        p = msg.pose.pose.position
-        return cls(p.x, p.y, p.z, roll, pitch, yaw, math.sqrt(v.x ** 2 + v.y ** 2 + v.z ** 2))
-
-    def four_wheels_on_top(self, height: float, wheel_radius: float,
-                           tolerance: float = 0.01) -> bool:
-        """The rear axle (base_link) at step height and the car level: with the rear wheels
-        up, the front ones, a wheelbase ahead, are too."""
-        return (abs(self.z - (height + wheel_radius)) < tolerance
-                and abs(self.pitch) < 0.05 and abs(self.roll) < 0.05)
 
 
 class SimSession:
@@ -79,11 +49,14 @@ class SimSession:
         ``-p`` overrides for planner_node.
     planner : bool
         Start planner_node (the car-like baseline is driven with cmd_vel only).
+    sim_parameters : mapping
+        ``-p`` overrides for sim_node, on top of the lockstep ones (e.g. ``start_paused``).
     """
 
     def __init__(self, robot_variant: str = 'swivel',
                  planner_parameters: dict[str, Any] | None = None,
-                 planner: bool = True) -> None:
+                 planner: bool = True,
+                 sim_parameters: dict[str, Any] | None = None) -> None:
         self.domain_id = next_domain_id()
         # The car-like baseline steers a turntable joint; the controller drives it the same way.
         joint = {'swivel_joint': 'steering_joint' if robot_variant == 'car_like'
@@ -102,9 +75,11 @@ class SimSession:
         self.processes: list[NodeProcess] = []
         try:
             for package, executable, parameters in specs:
+                overrides = sim_parameters if executable == 'sim_node' else None
                 self.processes.append(start_node(
                     package, executable, self.domain_id,
-                    {**parameters, **lockstep_parameters(executable, LOCKSTEP_TIMEOUT)}))
+                    {**parameters, **lockstep_parameters(executable, LOCKSTEP_TIMEOUT),
+                     **(overrides or {})}))
             os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
             self.context = rclpy.Context()
             rclpy.init(context=self.context, domain_id=self.domain_id)
@@ -221,9 +196,7 @@ class SimSession:
 
     def front_on_top(self, height: float, tolerance: float = 0.015) -> bool:
         """Ground truth: the front axle (wheelbase ahead of base_link) at step height."""
-        truth = self.truth
-        front = truth.z - self.wheelbase * math.sin(truth.pitch)
-        return front > height + self.wheel_radius - tolerance
+        return self.truth.front_on_top(height, self.wheel_radius, self.wheelbase, tolerance)
 
     def four_wheels_on_top(self, height: float, tolerance: float = 0.01) -> bool:
         return self.truth is not None and self.truth.four_wheels_on_top(

@@ -1,0 +1,24 @@
+from setuptools import find_packages, setup
+
+package_name = 'swivel_car_bringup'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml', 'README.md']),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='Swivel car team',
+    maintainer_email='team@swivel-car.invalid',
+    description='The swivel car stack wired in one process, without ROS, for design campaigns.',
+    license='Apache-2.0',
+    entry_points={
+        'console_scripts': [
+            'benchmark = swivel_car_bringup.benchmark:main',
+        ],
+    },
+)

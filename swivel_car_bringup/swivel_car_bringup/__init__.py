@@ -1,0 +1,1 @@
+"""The swivel car stack in one process, without ROS (see ``inprocess``)."""

@@ -1,0 +1,133 @@
+"""What the controller and odometry nodes do with one ``joint_states`` message, ROS-free.
+
+The nodes call these on the message's fields (stamp in seconds, names, positions,
+velocities); the in-process stack (``swivel_car_bringup.inprocess``) calls them on the sim
+core's state, so both run the same code on the same floats.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+from swivel_car_model.params import SwivelCarParams
+from swivel_car_model.planar import OffsetTricycleOdometry
+
+from swivel_car_control.core.controller import ControlOutput, SwivelController
+from swivel_car_control.joints import JointReader, JointSample
+
+# 'swivel': the offset tricycle's steering constraint (thesis II.E); 'rear_wheels': the yaw
+# rate from the rear wheels' rate difference (the speed from the model in both cases).
+YAW_RATE_SOURCES = ('swivel', 'rear_wheels')
+# A swivel reading this far past the joint limit (compliance, sensor noise) is clamped to it.
+LIMIT_SLACK = 0.05  # [rad]
+
+
+def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
+    """Rotation about z by ``yaw`` [rad] as a quaternion (x, y, z, w) [1]."""
+    return 0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw)
+
+
+class JointStateController:
+    """The controller's answer to one ``joint_states``: the swivel joint read by name (its
+    rate differenced from positions when not reported), then one ``SwivelController.step``.
+
+    Parameters
+    ----------
+    core : SwivelController
+    swivel_joint : str
+        Name of the swivel (or steering) joint in the message.
+    """
+
+    def __init__(self, core: SwivelController, swivel_joint: str) -> None:
+        self.core = core
+        self.swivel_joint = swivel_joint
+        self._joints = JointReader([swivel_joint])
+        self.last_time: float | None = None  # [s] stamp of the last message answered
+
+    def answer(self, t: float, names: Sequence[str], positions: Sequence[float],
+               velocities: Sequence[float]) -> tuple[JointSample, ControlOutput]:
+        """The swivel sample and the control output for the state of time ``t`` [s]
+        (positions [rad], velocities [rad/s], in the order of ``names``). Time going back
+        (a sim reset) forgets the previous positions.
+
+        Raises
+        ------
+        swivel_car_control.joints.MissingJointError
+            No usable swivel reading; nothing was stepped (answer with zero torque and drive).
+        """
+        if self.last_time is not None and t < self.last_time:
+            self._joints.reset()
+        swivel = self._joints.read(t, names, positions, velocities)[self.swivel_joint]
+        self.last_time = t
+        return swivel, self.core.step(t, swivel.position, swivel.rate)
+
+
+class JointStateOdometry:
+    """Offset-tricycle odometry (``OffsetTricycleOdometry``) fed from ``joint_states``, and
+    when to publish it: by joint_states time, at most one message per state, so that in a
+    lockstep sim every run publishes the same poses.
+
+    Parameters
+    ----------
+    car : SwivelCarParams
+    swivel_joint, rear_left_wheel_joint, rear_right_wheel_joint : str
+        Joint names in the message.
+    yaw_rate_source : str
+        One of ``YAW_RATE_SOURCES``.
+    publish_rate : float
+        Odometry messages per second of joint_states time, > 0. # [Hz]
+    """
+
+    def __init__(self, car: SwivelCarParams, swivel_joint: str, rear_left_wheel_joint: str,
+                 rear_right_wheel_joint: str, yaw_rate_source: str,
+                 publish_rate: float) -> None:
+        if yaw_rate_source not in YAW_RATE_SOURCES:
+            raise ValueError(f'yaw_rate_source must be one of {YAW_RATE_SOURCES}, got '
+                             f'{yaw_rate_source!r}')
+        if not (math.isfinite(publish_rate) and publish_rate > 0.0):
+            raise ValueError(f'publish_rate must be > 0 Hz, got {publish_rate!r}')
+        self.car = car
+        self.odometry = OffsetTricycleOdometry(car)
+        self._names = (swivel_joint, rear_left_wheel_joint, rear_right_wheel_joint)
+        self._rear_wheels_yaw = yaw_rate_source == 'rear_wheels'
+        self._period = 1.0 / publish_rate  # [s]
+        self._joints = JointReader(self._names)
+        self.last_time: float | None = None  # [s] of the last joint_states used
+        self._next_publish: float | None = None  # [s] joint_states time of the next odom
+
+    def update(self, t: float, names: Sequence[str], positions: Sequence[float],
+               velocities: Sequence[float]) -> bool:
+        """Integrate the state of time ``t`` [s] (positions [rad], velocities [rad/s] in the
+        order of ``names``); returns whether an odometry message is due now. Time going back
+        (a sim reset) restarts the integration, the pose kept.
+
+        Raises
+        ------
+        swivel_car_control.joints.MissingJointError
+            A joint is missing; the odometry is not updated.
+        ValueError
+            The model refuses the values; the odometry is not updated.
+        """
+        if self.last_time is not None and t < self.last_time:
+            self._joints.reset()
+            self.last_time = None
+            self._next_publish = None
+        joints = self._joints.read(t, names, positions, velocities)
+        swivel_name, left_name, right_name = self._names
+        swivel = joints[swivel_name]
+        limit = self.car.max_swivel_angle
+        theta2 = swivel.position
+        if abs(theta2) <= limit + LIMIT_SLACK:
+            theta2 = max(-limit, min(limit, theta2))
+        left, right = joints[left_name].rate, joints[right_name].rate
+        difference = right - left if self._rear_wheels_yaw else None
+        dt = 0.0 if self.last_time is None else t - self.last_time
+        self.odometry.update(theta2, swivel.rate, 0.5 * (left + right), dt, difference)
+        self.last_time = t
+        period = self._period
+        if self._next_publish is None or t >= self._next_publish - 1e-9:
+            due = (t if self._next_publish is None else self._next_publish) + period
+            self._next_publish = due if due > t else t + period
+            return True
+        return False
