@@ -17,8 +17,6 @@ setup(
     description='The swivel car stack wired in one process, without ROS, for design campaigns.',
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [
-            'benchmark = swivel_car_bringup.benchmark:main',
-        ],
+        'console_scripts': [],
     },
 )

@@ -33,7 +33,7 @@ def main(argv: list[str] | None = None) -> None:
     with InProcessStack() as plain:
         plain.spawn_step(args.height, args.distance)
         planning = time.perf_counter()
-        make_plan(plain.config.planner_car, plain.config.planner, request)
+        make_plan(plain.car, plain.config.planner, request)
         planning = time.perf_counter() - planning
         wall = time.perf_counter()
         result = plain.climb(request)

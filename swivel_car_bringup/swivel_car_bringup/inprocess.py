@@ -38,13 +38,13 @@ import yaml
 from swivel_car_control.core.controller import ControlOutput, ControllerConfig, SwivelController
 from swivel_car_control.core.joint_states import (
     JointStateController, JointStateOdometry, yaw_quaternion)
-from swivel_car_control.gains import TUNED_GAINS
 from swivel_car_control.joints import MissingJointError
-from swivel_car_model.params import SwivelCarParams
+from swivel_car_model import description
+from swivel_car_model.description import CarDescription
 from swivel_car_planner.core import (
     ClimbPlan, ClimbRequest, ClimbStateMachine, Command, ErrorCode, Outcome, PlanError,
     PlannerConfig, make_plan, validate_request)
-from swivel_car_planner.core import inputs
+from swivel_car_planner.core import capability, inputs
 from swivel_car_planner.core.sync import InputSync
 from swivel_car_planner.ground_truth import GroundTruth
 from swivel_car_sim.config import PARAMETERS as SIM_PARAMETERS, SimNodeConfig
@@ -116,10 +116,12 @@ class StackConfig:
     ----------
     sim : SimNodeConfig
         The sim node's (physics, control period, IMU and ground-truth rates).
-    controller_car, odometry_car, planner_car : SwivelCarParams
-        The robot as each node declares it (the controller's gains are its tuned ones).
+    robot : CarDescription
+        The robot description every node declares.
     controller : ControllerConfig
     planner : PlannerConfig
+    whole_car_limit : float
+        The planner's, from its capability table (``capability_file``). # [m]
     steer_joint : str
         The joint the controller, odometry and planner read ('swivel_joint', or
         'steering_joint' for the car-like baseline).
@@ -130,11 +132,10 @@ class StackConfig:
     """
 
     sim: SimNodeConfig
-    controller_car: SwivelCarParams
+    robot: CarDescription
     controller: ControllerConfig
-    odometry_car: SwivelCarParams
-    planner_car: SwivelCarParams
     planner: PlannerConfig
+    whole_car_limit: float
     steer_joint: str
     rear_left_wheel_joint: str
     rear_right_wheel_joint: str
@@ -170,7 +171,7 @@ class StackConfig:
                              f'{robot_variant!r}')
         robot, sim, controller = dict(robot or {}), dict(sim or {}), dict(controller or {})
         odometry, planner = dict(odometry or {}), dict(planner or {})
-        car_names = {item.name for item in fields(SwivelCarParams)}
+        car_names = set(description.PARAMETERS)
         sim_names = set(SIM_PARAMETERS)
         _check_names('robot', robot, car_names | sim_names)
         joint = {'swivel_joint': _STEER_JOINT[robot_variant]}
@@ -188,26 +189,30 @@ class StackConfig:
             return {**installed, **{k: v for k, v in robot.items() if k in car_names},
                     **joint, **overrides}
 
-        controller_names = car_names | {item.name for item in fields(ControllerConfig)}
+        controller_names = car_names | {item.name for item in fields(ControllerConfig)} \
+            - {'max_torque'}
         c = node_values('swivel_car_control', 'controller_node', 'controller', controller,
                         controller_names | {'swivel_joint'})
         o = node_values('swivel_car_control', 'odometry_node', 'odometry', odometry,
                         car_names)
         p = node_values('swivel_car_planner', 'planner_node', 'planner', planner,
-                        car_names | {item.name for item in fields(PlannerConfig)})
+                        car_names | {item.name for item in fields(PlannerConfig)}
+                        | {'capability_file'})
         for name in ('publish_rate', 'rear_left_wheel_joint', 'rear_right_wheel_joint',
                      'yaw_rate_source'):
             if name not in o:
                 raise ValueError(f'the odometry parameter {name} is not in the installed '
                                  'odometry_node.yaml')
+        robot_description = sim_config.physics.description
+        table, _ = capability.table_for(p.get('capability_file', capability.INSTALLED))
         # The planner's swivel_joint must be the controller's: one joint steers.
         return cls(
             sim=sim_config,
-            controller_car=_dataclass_from(SwivelCarParams, c, TUNED_GAINS),
-            controller=_dataclass_from(ControllerConfig, c),
-            odometry_car=_dataclass_from(SwivelCarParams, o),
-            planner_car=_dataclass_from(SwivelCarParams, p, cast=float),
+            robot=robot_description,
+            controller=_dataclass_from(
+                ControllerConfig, {**c, 'max_torque': robot_description.swivel_torque_limit}),
             planner=_dataclass_from(PlannerConfig, p, cast=float),
+            whole_car_limit=math.inf if table is None else table.limit,
             steer_joint=c['swivel_joint'],
             rear_left_wheel_joint=o['rear_left_wheel_joint'],
             rear_right_wheel_joint=o['rear_right_wheel_joint'],
@@ -344,10 +349,11 @@ class InProcessStack:
     def _start_nodes(self) -> None:
         """Fresh controller, odometry and planner memories (as freshly started nodes)."""
         c = self.config
+        self.car = c.robot.model_params()
         self.controller = JointStateController(
-            SwivelController(c.controller_car, c.controller), c.steer_joint)
+            SwivelController(self.car, c.controller), c.steer_joint)
         self.odometry = JointStateOdometry(
-            c.odometry_car, c.steer_joint, c.rear_left_wheel_joint, c.rear_right_wheel_joint,
+            self.car, c.steer_joint, c.rear_left_wheel_joint, c.rear_right_wheel_joint,
             c.yaw_rate_source, c.odometry_publish_rate)
         self._sync = InputSync(inputs.INPUTS, inputs.CONTROLLER_STATE)
         self.machine: ClimbStateMachine | None = None
@@ -560,13 +566,14 @@ class InProcessStack:
         if code != ErrorCode.NONE:
             return self._result(False, code, message, None, None, start)
         try:
-            plan = make_plan(self.config.planner_car, self.config.planner, request)
+            plan = make_plan(self.car, self.config.planner, request,
+                             self.config.whole_car_limit)
         except PlanError as error:
             return self._result(False, error.code, error.message, None, None, start)
         if request.plan_only:
             return self._result(True, ErrorCode.NONE, 'plan only: the robot did not move',
                                 plan, None, start)
-        machine = ClimbStateMachine(self.config.planner_car, self.config.planner, plan,
+        machine = ClimbStateMachine(self.car, self.config.planner, plan,
                                     request.step_distance, request.step_yaw,
                                     request.time_allowance)
         self.machine = machine
@@ -612,11 +619,11 @@ class InProcessStack:
     def front_on_top(self, height: float, tolerance: float = 0.015) -> bool:
         """Ground truth: the front axle (a wheelbase ahead of base_link) at the height
         [m] of the step, within ``tolerance`` [m]."""
-        car = self.config.planner_car
+        car = self.car
         return self.ground_truth().front_on_top(height, car.r, car.wheelbase, tolerance)
 
     def four_wheels_on_top(self, height: float, tolerance: float = 0.01) -> bool:
         """Ground truth: the rear axle at the height [m] of the step within ``tolerance``
         [m], and the car level (so the front axle is up too)."""
-        return self.ground_truth().four_wheels_on_top(height, self.config.planner_car.r,
+        return self.ground_truth().four_wheels_on_top(height, self.car.r,
                                                       tolerance)

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from swivel_car_model.description import CarDescription
 
 from swivel_car_bringup.inprocess import InProcessStack, StackConfig
 from swivel_car_planner.core import ClimbRequest, ErrorCode
@@ -19,12 +20,12 @@ def stack():
 
 
 def test_configuration_is_the_installed_one_with_overrides():
-    config = StackConfig.installed(robot={'mass': 23.0}, planner={'climb_speed': 2.5})
-    assert config.controller_car.kp == 150.0  # the tuned gains, from controller_node.yaml
+    config = StackConfig.installed(robot={'body_mass': 5.0}, planner={'climb_speed': 2.5})
+    assert config.robot == CarDescription(body_mass=5.0)
+    assert config.sim.physics.description == config.robot
+    assert config.controller.max_torque == config.robot.swivel_torque_limit
     assert config.planner.climb_speed == 2.5
     assert config.sim.control_period == 0.01 and config.sim.steps_per_period == 5
-    for car in (config.controller_car, config.odometry_car, config.planner_car):
-        assert car.mass == 23.0
     assert StackConfig.installed('car_like').steer_joint == 'steering_joint'
     with pytest.raises(ValueError, match='climb_sped'):
         StackConfig.installed(planner={'climb_sped': 2.5})
@@ -40,7 +41,7 @@ def test_a_short_drive_moves_forward_and_records_every_period(stack):
     trajectory = stack.trajectory()
     assert len(trajectory) == 100
     assert np.all(np.diff(trajectory.time) > 0.0)
-    assert trajectory.drive_speed[-1] == pytest.approx(0.3 / stack.config.controller_car.r)
+    assert trajectory.drive_speed[-1] == pytest.approx(0.3 / stack.config.robot.r)
     # The cmd_vel deadman stops the car once drive() no longer renews the command.
     stack.settle(1.5)
     assert stack.ground_truth().speed < 0.01

@@ -18,16 +18,14 @@ from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelController
 from swivel_car_control.conversions import is_zero_stamp, stamp_to_seconds
 from swivel_car_control.core.controller import ControllerConfig, SwivelController
 from swivel_car_control.core.joint_states import JointStateController
-from swivel_car_control.gains import TUNED_GAINS
 from swivel_car_control.joints import MissingJointError
 from swivel_car_control.ros_params import (
-    declare_car_params, declare_dataclass, refuse_runtime_changes, run_node)
+    declare_dataclass, declare_description, refuse_runtime_changes, run_node)
 
 # A cmd_vel stamped further than this ahead of the node clock is taken as arriving now.
 _CLOCK_SLACK = 0.5  # [s]
 
 CONFIG_DESCRIPTIONS = {
-    'max_torque': 'swivel torque clamp [N m]',
     'max_integral_torque': 'clamp on the PID integral contribution [N m]',
     'integral_band': 'the PID integrates only while |error| is below this [rad]',
     'swivel_limit': 'largest |swivel set point|, <= max_swivel_angle; reduced further to keep '
@@ -50,10 +48,12 @@ CONFIG_DESCRIPTIONS = {
 class ControllerNode(Node):
     """Event-driven swivel car controller; see the package README for its interface."""
 
-    def __init__(self) -> None:
-        super().__init__('controller')
-        car = declare_car_params(self, TUNED_GAINS)
-        config = declare_dataclass(self, ControllerConfig, CONFIG_DESCRIPTIONS)
+    def __init__(self, **kwargs) -> None:
+        super().__init__('controller', **kwargs)
+        robot = declare_description(self)
+        car = robot.model_params()
+        config = declare_dataclass(self, ControllerConfig, CONFIG_DESCRIPTIONS,
+                                   given={'max_torque': robot.swivel_torque_limit})
         self._use_stamped = self.declare_parameter(
             'use_stamped', True, ParameterDescriptor(
                 description='cmd_vel is geometry_msgs/TwistStamped (true) or Twist')).value
@@ -73,8 +73,8 @@ class ControllerNode(Node):
                             "sim's lockstep_timeout [s]")).value
         if not (math.isfinite(self._lockstep_wait) and self._lockstep_wait > 0.0):
             raise ValueError(f'lockstep_wait must be > 0 s, got {self._lockstep_wait!r}')
-        refuse_runtime_changes(self, {f.name for f in dataclasses.fields(car)}
-                               | {f.name for f in dataclasses.fields(config)}
+        refuse_runtime_changes(self, {f.name for f in dataclasses.fields(robot)}
+                               | set(CONFIG_DESCRIPTIONS)
                                | {'use_stamped', 'swivel_joint', 'lockstep_swivel_command',
                                   'lockstep_wait'})
         self._core = SwivelController(car, config)

@@ -19,7 +19,7 @@ from swivel_car_control.conversions import stamp_to_seconds, yaw_to_quaternion
 from swivel_car_control.core.joint_states import JointStateOdometry, YAW_RATE_SOURCES
 from swivel_car_control.joints import MissingJointError
 from swivel_car_control.ros_params import (
-    declare_car_params, declare_dataclass, refuse_runtime_changes, run_node)
+    declare_dataclass, declare_description, refuse_runtime_changes, run_node)
 
 
 @dataclass(frozen=True)
@@ -91,11 +91,12 @@ def _diagonal(values: tuple) -> list[float]:
 class OdometryNode(Node):
     """Offset-tricycle odometry; see the package README for its interface."""
 
-    def __init__(self) -> None:
-        super().__init__('odometry')
-        self._car = declare_car_params(self)
+    def __init__(self, **kwargs) -> None:
+        super().__init__('odometry', **kwargs)
+        robot = declare_description(self)
+        self._car = robot.model_params()
         self._config = config = declare_dataclass(self, OdometryConfig, CONFIG_DESCRIPTIONS)
-        refuse_runtime_changes(self, {f.name for f in dataclasses.fields(self._car)}
+        refuse_runtime_changes(self, {f.name for f in dataclasses.fields(robot)}
                                | {f.name for f in dataclasses.fields(config)})
         self._joint_odometry = JointStateOdometry(
             self._car, config.swivel_joint, config.rear_left_wheel_joint,

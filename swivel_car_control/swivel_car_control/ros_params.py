@@ -9,38 +9,26 @@ import rclpy
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
-from swivel_car_model.params import SwivelCarParams
+from swivel_car_model import description
+from swivel_car_model.description import CarDescription
 
 T = TypeVar('T')
 
-CAR_DESCRIPTIONS = {
-    'l': 'T column length, axle centre to apex [m]',
-    'h': 'half wheel shaft: wheel centre plane to the column [m]',
-    'phi': 'angle between the T columns (each rises at phi/2) [rad]',
-    'r': 'wheel radius [m]',
-    'mass': 'total mass [kg]',
-    'inertia': 'inertia about the rear axle (thesis I_s) [kg m^2]',
-    'kp': 'swivel PID proportional gain [N m/rad]',
-    'ki': 'swivel PID integral gain [N m/(rad s)]',
-    'kd': 'swivel PID derivative gain, on the measured rate [N m s/rad]',
-    'wheel_width': 'wheel tread width [m]',
-    'wheel_mass': 'mass of one wheel [kg]',
-    'max_swivel_angle': 'mechanical swivel joint limit, symmetric [rad]',
-}
-
-
 def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],
-                      defaults: Mapping[str, Any] | None = None) -> T:
-    """Declare one parameter per field of ``cls`` and build it from their values.
+                      given: Mapping[str, Any] | None = None) -> T:
+    """Declare one parameter per field of ``cls`` (but those ``given``, stated elsewhere)
+    and build it from their values.
 
     Raises
     ------
     ValueError
         The dataclass refuses the values; the message names the field.
     """
-    values = {}
+    values = dict(given or {})
     for field in dataclasses.fields(cls):
-        default = (defaults or {}).get(field.name, field.default)
+        if field.name in values:
+            continue
+        default = field.default
         if isinstance(default, int) and not isinstance(default, bool):
             default = float(default)
         value = node.declare_parameter(
@@ -52,11 +40,19 @@ def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],
     return cls(**values)
 
 
-def declare_car_params(node: Node, defaults: Mapping[str, Any] | None = None
-                       ) -> SwivelCarParams:
-    """The car's geometry, masses and swivel gains as parameters (defaults: thesis Table 2,
-    unless ``defaults`` overrides some)."""
-    return declare_dataclass(node, SwivelCarParams, CAR_DESCRIPTIONS, defaults)
+def declare_description(node: Node) -> CarDescription:
+    """The robot description as parameters, the same names and defaults in every node
+    (``swivel_car_model.description``).
+
+    Raises
+    ------
+    ValueError
+        A value the description refuses; the message names the parameter.
+    """
+    return CarDescription.from_values({
+        name: node.declare_parameter(
+            name, default, ParameterDescriptor(description=text, dynamic_typing=True)).value
+        for name, (default, text) in description.PARAMETERS.items()})
 
 
 def refuse_runtime_changes(node: Node, names: set[str]) -> None:

@@ -12,7 +12,8 @@ def request_from(message, with_time_allowance: bool) -> ClimbRequest:
     return ClimbRequest(
         step_height=float(message.step_height), step_distance=float(message.step_distance),
         step_yaw=float(message.step_yaw), plan_only=bool(message.plan_only),
-        time_allowance=float(message.time_allowance) if with_time_allowance else 0.0)
+        time_allowance=float(message.time_allowance) if with_time_allowance else 0.0,
+        step_width=float(message.step_width), step_offset=float(message.step_offset))
 
 
 def plan_to_msg(plan: ClimbPlan) -> ClimbPlanMsg:

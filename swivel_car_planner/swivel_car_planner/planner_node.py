@@ -26,7 +26,8 @@ from rclpy.task import Future
 from rcl_interfaces.msg import ParameterDescriptor
 from sensor_msgs.msg import Imu, JointState
 from swivel_car_model import kinematics
-from swivel_car_model.params import SwivelCarParams
+from swivel_car_model import description
+from swivel_car_model.description import CarDescription
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
@@ -36,20 +37,11 @@ from swivel_car_planner.core import (
     ClimbRequest, ClimbStateMachine, Command, ErrorCode, PlanError,
     PlannerConfig, make_plan, validate_request)
 from swivel_car_planner.core import inputs
+from swivel_car_planner.core import capability
 from swivel_car_planner.core.sync import InputSync, Tick
 
 _CONTROLLER_STATE = inputs.CONTROLLER_STATE
 _INPUTS = inputs.INPUTS
-
-_ROBOT_DESCRIPTIONS = {
-    'l': 'length of each T column [m]', 'h': 'half-length of each wheel shaft [m]',
-    'phi': 'angle between the T columns [rad]', 'r': 'wheel radius [m]',
-    'mass': 'total mass [kg]', 'inertia': 'inertia about the rear axle [kg m^2]',
-    'kp': 'swivel P gain [N m/rad]', 'ki': 'swivel I gain [N m/(rad s)]',
-    'kd': 'swivel D gain [N m s/rad]', 'wheel_width': 'wheel tread width [m]',
-    'wheel_mass': 'mass of each wheel [kg]', 'max_swivel_angle': 'swivel joint limit [rad]',
-}
-
 
 @dataclass
 class _ActiveClimb:
@@ -86,12 +78,17 @@ class PlannerNode(Node):
                 item.name, item.default,
                 ParameterDescriptor(description=item.metadata['description'])).value)
             for item in fields(PlannerConfig)})
-        defaults = SwivelCarParams()
-        self.robot = SwivelCarParams(**{
-            name: float(self.declare_parameter(
-                name, float(getattr(defaults, name)),
-                ParameterDescriptor(description=description)).value)
-            for name, description in _ROBOT_DESCRIPTIONS.items()})
+        self.description = CarDescription.from_values({
+            name: self.declare_parameter(
+                name, default, ParameterDescriptor(description=text,
+                                                   dynamic_typing=True)).value
+            for name, (default, text) in description.PARAMETERS.items()})
+        self.robot = self.description.model_params()
+        self.whole_car_limit = self._load_capability(self.declare_parameter(
+            'capability_file', capability.INSTALLED, ParameterDescriptor(
+                description="the measured whole-car capability table (YAML); 'installed': "
+                            "the package's config/capability.yaml; 'none': no table, only "
+                            "the model's limits")).value)
         self._ready_timeout = self._positive_parameter(
             'ready_timeout', 1.0, 'inputs older than this (sim time) mean not ready; a climb '
                                   'whose inputs stop for this long aborts [s]')
@@ -130,6 +127,29 @@ class PlannerNode(Node):
         if not math.isfinite(value) or value <= 0.0:
             raise ValueError(f'parameter {name} must be finite and > 0, got {value!r}')
         return value
+
+    def _load_capability(self, value: str) -> float:
+        """The highest step the whole car climbs reliably, from the table ``value`` names
+        (``capability.table_for``). # [m]
+
+        Raises
+        ------
+        ValueError
+            The file cannot be read as a table.
+        """
+        table, path = capability.table_for(value)
+        if table is None:
+            self.get_logger().warning('no capability table: steps are refused only by the '
+                                      "model's limits, the rear axle may not follow")
+            return math.inf
+        if not table.matches(self.description):
+            self.get_logger().warning(
+                f'the capability table {path} was measured on another robot description; '
+                'its limit may not hold for this one (regenerate it: python -m '
+                'swivel_car_planner.benchmark --write-capability)')
+        self.get_logger().info(f'whole-car limit {table.limit:.3f} m (success >= '
+                               f'{table.reliable:.0%} in {path})')
+        return table.limit
 
     def _max_step(self) -> float:
         return kinematics.max_scalable_step(self.robot)[0]
@@ -185,7 +205,7 @@ class PlannerNode(Node):
                                  f'no recent message on {", ".join(missing)}: are the sim, '
                                  f'controller and odometry running?')
         try:
-            plan = make_plan(self.robot, self.config, request)
+            plan = make_plan(self.robot, self.config, request, self.whole_car_limit)
         except PlanError as error:
             return self._failure(error.code, error.message)
         if request.plan_only:
@@ -316,15 +336,20 @@ class PlannerNode(Node):
 def main(args=None) -> None:
     rclpy.init(args=args)
     node = None
+    code = 0
     try:
         node = PlannerNode()
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except ValueError as error:
+        rclpy.logging.get_logger('planner').fatal(f'bad configuration: {error}')
+        code = 1
     finally:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+    raise SystemExit(code)
 
 
 if __name__ == '__main__':

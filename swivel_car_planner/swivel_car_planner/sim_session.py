@@ -177,11 +177,11 @@ class SimSession:
         return response.name
 
     def climb(self, height: float, distance: float, yaw: float = 0.0,
-              plan_only: bool = False) -> ClimbStep.Response:
+              plan_only: bool = False, width: float = 0.0) -> ClimbStep.Response:
         """The climb_step service call users make; returns when the climb ends."""
         return self.call(self.climb_client, ClimbStep.Request(
-            step_height=height, step_distance=distance, step_yaw=yaw, plan_only=plan_only),
-            timeout=CLIMB_WALL_LIMIT)
+            step_height=height, step_distance=distance, step_yaw=yaw, plan_only=plan_only,
+            step_width=width), timeout=CLIMB_WALL_LIMIT)
 
     def drive_straight(self, drive_speed: float, seconds: float) -> None:
         """Hold the steering at 0 and drive for ``seconds`` of sim time, then stop. The

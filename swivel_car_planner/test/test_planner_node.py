@@ -26,7 +26,7 @@ from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
 from swivel_car_testing import next_domain_id, spin_until
-from swivel_car_model.params import SwivelCarParams
+from swivel_car_model import description
 
 from swivel_car_planner.core import Command, ErrorCode, Phase, PlannerConfig
 from swivel_car_planner.kinematic_car import KinematicCar
@@ -312,11 +312,11 @@ class _Deadline:
 def test_config_file_matches_the_declared_defaults():
     path = Path(__file__).resolve().parents[1] / 'config' / 'planner_node.yaml'
     values = yaml.safe_load(path.read_text())['/**']['planner']['ros__parameters']
-    config, robot = PlannerConfig(), SwivelCarParams()
+    config = PlannerConfig()
     for item in fields(PlannerConfig):
         assert values[item.name] == pytest.approx(getattr(config, item.name)), item.name
-    for item in fields(SwivelCarParams):
-        assert values[item.name] == pytest.approx(getattr(robot, item.name)), item.name
+    # The robot is stated once, in the description: the file does not repeat it.
+    assert not set(values) & set(description.PARAMETERS)
 
 
 def test_bad_parameter_is_a_clear_error_at_start():

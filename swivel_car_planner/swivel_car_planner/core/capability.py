@@ -29,6 +29,8 @@ import yaml
 from swivel_car_model.description import CarDescription
 
 RELIABLE = 0.9  # [1] success rate that counts as "climbs reliably"
+INSTALLED = 'installed'  # the table shipped in the package's share/config/capability.yaml
+NONE = 'none'  # no table: only the model's limits
 
 
 @dataclass(frozen=True)
@@ -111,3 +113,21 @@ class CapabilityTable:
 def description_values(description: CarDescription) -> dict[str, Any]:
     """The description's fields as plain values (what a table records)."""
     return {item.name: getattr(description, item.name) for item in fields(description)}
+
+
+def table_for(value: str) -> tuple[CapabilityTable | None, str]:
+    """The table a ``capability_file`` parameter names, and its path: ``INSTALLED`` (the
+    package's), ``NONE`` (no table: None) or a file path.
+
+    Raises
+    ------
+    ValueError
+        The file cannot be read as a table; the message names it.
+    """
+    if value == NONE:
+        return None, ''
+    if value == INSTALLED:
+        from ament_index_python.packages import get_package_share_directory
+        value = str(Path(get_package_share_directory('swivel_car_planner'))
+                    / 'config' / 'capability.yaml')
+    return CapabilityTable.load(value), value

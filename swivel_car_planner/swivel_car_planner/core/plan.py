@@ -225,6 +225,11 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
                         f'a {height:.3f} m step plus {config.clearance_margin:.3f} m clearance '
                         f'is beyond the lifted wheel\'s reach ({reach:.3f} m): {error}') \
             from error
+    if height > whole_car_limit:
+        raise PlanError(ErrorCode.UNREACHABLE_HEIGHT,
+                        f'the front wheels could lift over {height:.3f} m, but the whole car '
+                        f'climbs reliably only up to {whole_car_limit:.3f} m (the rear axle '
+                        f'climbs by traction; measured in the sim, the capability table)')
     theta1 = float(kinematics.lift_angle(p, theta2))
     tip_margin = float(kinematics.tip_over_margin(p, theta1))
     if tip_margin < config.tip_over_margin:
@@ -243,11 +248,6 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
         raise PlanError(ErrorCode.TORQUE_LIMIT,
                         f'the climb needs a peak swivel torque of {peak_torque:.2f} N m, above '
                         f'the actuator limit of {config.torque_limit:.2f} N m')
-    if height > whole_car_limit:
-        raise PlanError(ErrorCode.UNREACHABLE_HEIGHT,
-                        f'the front wheels could lift over {height:.3f} m, but the whole car '
-                        f'climbs reliably only up to {whole_car_limit:.3f} m (the rear axle '
-                        f'climbs by traction; measured in the sim, the capability table)')
 
     # Lift the wheel on the side that leads already, so the car turns the least; with the
     # step's extent known, on the side whose natural crossing of the edge lies nearer the
