@@ -149,16 +149,9 @@ class CarDescription:
 
     # --- derived quantities ---------------------------------------------------------------
 
-    @property
-    def wheelbase(self) -> float:
-        """Rear axle to front axle at zero swivel. # [m]"""
-        return 2.0 * self.l * math.cos(self.phi / 2.0)
-
-    @property
-    def apex(self) -> np.ndarray:
-        """Apex of the columns in base_link at rest. # [m]"""
-        return np.array([self.l * math.cos(self.phi / 2.0), 0.0,
-                         self.l * math.sin(self.phi / 2.0)])
+    # The model's geometry, read from the same l and phi (not dataclass fields).
+    wheelbase = SwivelCarParams.wheelbase
+    apex = SwivelCarParams.apex
 
     def parts(self, variant: str = 'swivel') -> list['Part']:
         """The rigid pieces of the robot with their masses and inertias, in base_link at

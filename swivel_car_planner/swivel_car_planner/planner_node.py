@@ -36,12 +36,12 @@ from swivel_car_planner.conversions import outcome_to_msg, plan_to_msg, request_
 from swivel_car_planner.core import (
     ClimbRequest, ClimbStateMachine, Command, ErrorCode, PlanError,
     PlannerConfig, make_plan, validate_request)
-from swivel_car_planner.core import inputs
-from swivel_car_planner.core import capability
+from swivel_car_planner.core import capability, inputs
 from swivel_car_planner.core.sync import InputSync, Tick
 
 _CONTROLLER_STATE = inputs.CONTROLLER_STATE
 _INPUTS = inputs.INPUTS
+
 
 @dataclass
 class _ActiveClimb:
