@@ -39,7 +39,7 @@ bench: build
 	$(IN_WS) python -m swivel_car_model.benchmark
 	$(IN_WS) python -m swivel_car_sim.benchmark
 	$(IN_WS) python -m swivel_car_control.benchmark
-	$(IN_WS) python -m swivel_car_planner.benchmark $(PLANNER_BENCH_ARGS)
+	$(IN_WS) python -m swivel_car_bringup.climb_benchmark $(CLIMB_BENCH_ARGS)
 
 clean:
 	rm -rf ros2_ws/build ros2_ws/install ros2_ws/log

@@ -141,7 +141,7 @@ class DemoError(RuntimeError):
 
 def demo_step(args: argparse.Namespace) -> StepSpec:
     """The step the demo spawns, square across the car's path."""
-    return StepSpec(name='demo_step', height=args.step_height, depth=1.0, width=1.6,
+    return StepSpec(name='demo_step', height=args.step_height, depth=1.0, width=2.4,
                     distance=args.step_distance, yaw=0.0, friction=1.0)
 
 
@@ -201,7 +201,7 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
 
         goal = ClimbStep.Goal(step_height=args.step_height,
                               step_distance=args.step_distance - travelled(), step_yaw=0.0,
-                              plan_only=False, time_allowance=args.time_allowance)
+                              step_width=step.width, plan_only=False, time_allowance=args.time_allowance)
         climb_start = node.recording.truth[-1][0]
         sent = node.climb.send_goal_async(goal, feedback_callback=lambda f: progress.show(
             f.feedback.phase_name, f'{100 * f.feedback.progress:3.0f} %  swivel '
@@ -262,7 +262,8 @@ def summarise(args, recording: Recording, result, climb_start: float, climb_end:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--step-height', type=float, default=0.04, help='[m]')
+    parser.add_argument('--step-height', type=float, default=0.04,
+                        help='[m] (the default robot\'s whole-car limit, capability.yaml)')
     parser.add_argument('--step-distance', type=float, default=1.8,
                         help='[m] front axle ground contact to the step edge at the start')
     parser.add_argument('--stop-before', type=float, default=1.0,

@@ -286,6 +286,9 @@ class ClimbResult:
         Sim time of the climb's first tick (the first state the state machine saw). # [s]
     trajectory : Trajectory
         The climb's control periods, from its first tick to its last.
+    steps : tuple of (float, str)
+        The state machine's steps (``state_machine.Step`` names) with the sim time each
+        began. # [s]
     """
 
     success: bool
@@ -295,6 +298,17 @@ class ClimbResult:
     outcome: Outcome | None
     start_time: float
     trajectory: Trajectory
+    steps: tuple[tuple[float, str], ...] = ()
+
+    def step_window(self, name: str) -> tuple[float, float]:
+        """Sim times [s] from the start of step ``name`` to the start of the next one (or
+        the climb's end); (inf, inf) if the climb never reached it."""
+        for index, (start, step) in enumerate(self.steps):
+            if step == name:
+                end = (self.steps[index + 1][0] if index + 1 < len(self.steps)
+                       else math.inf)
+                return start, end
+        return math.inf, math.inf
 
 
 # --- the stack -----------------------------------------------------------------------------
@@ -357,6 +371,7 @@ class InProcessStack:
             c.yaw_rate_source, c.odometry_publish_rate)
         self._sync = InputSync(inputs.INPUTS, inputs.CONTROLLER_STATE)
         self.machine: ClimbStateMachine | None = None
+        self._steps: list[tuple[float, str]] = []
         self._cmd_vel: tuple[float, float] | None = None
         self.last_output: ControlOutput | None = None
 
@@ -498,6 +513,8 @@ class InProcessStack:
         if machine is None:
             return
         commands = [self._timed('state_machine', machine.update, inputs.observation(tick))]
+        if not self._steps or self._steps[-1][1] != machine.step.name:
+            self._steps.append((tick.time, machine.step.name))
         if machine.outcome is not None:
             commands += inputs.end_commands(machine.outcome)
         for command in commands:
@@ -562,6 +579,7 @@ class InProcessStack:
         ClimbResult
         """
         start, first_row = self.time, len(self._rows)
+        self._steps = []
         code, message = validate_request(request, self.config.planner)
         if code != ErrorCode.NONE:
             return self._result(False, code, message, None, None, start)
@@ -597,7 +615,7 @@ class InProcessStack:
                 outcome: Outcome | None, start: float,
                 rows: slice = slice(0, 0)) -> ClimbResult:
         return ClimbResult(success, ErrorCode(code), message, plan, outcome, start,
-                           self.trajectory(rows))
+                           self.trajectory(rows), tuple(self._steps))
 
     # --- ground truth --------------------------------------------------------------------
 

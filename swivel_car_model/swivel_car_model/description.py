@@ -20,6 +20,14 @@ x forward, y left, z up)::
     front_t:   front column (rod from the apex to the front axle), front axle housing
     wheels:    four solid discs at (0, +-h, 0) and (wheelbase, +-h, 0)
 
+Mass layout and drive train. The defaults match the thesis' I_s = 0.84 kg m^2 with the heavy
+parts in the rear axle housing (centre of mass at 24 % of the wheelbase), open differentials
+and a 10 N m drive: the car turns and its odometry is as the thesis models it, but the whole
+car climbs only 4 cm. ``config/designs/climbing.yaml`` is the design that climbs 7 cm
+(docs/climbing_design.md): the swivel lifts whichever axle is lighter, and once the front is
+on the step the rear axle climbs by traction, which wants weight on the front wheels and both
+wheels of each axle driven.
+
 Swivel gains. Thesis Table 2 (kp 19 N m/rad, ki 11.45 N m/(rad s), kd 5.5 N m s/rad, the
 documented starting point and ``SwivelCarParams``' defaults) is far too soft for the simulated car: the
 swivel must lift the body (about 5 N m of gravity load at 0.5 rad), so with kp = 19 the
@@ -216,7 +224,8 @@ class CarDescription:
             l=self.l, h=self.h, phi=self.phi, r=self.r,
             mass=sum(part.mass for part in parts), inertia=inertia_about_y_axis(parts),
             kp=self.kp, ki=self.ki, kd=self.kd, wheel_width=self.wheel_width,
-            wheel_mass=self.wheel_mass, max_swivel_angle=self.max_swivel_angle)
+            wheel_mass=self.wheel_mass, max_swivel_angle=self.max_swivel_angle,
+            swivel_torque_limit=self.swivel_torque_limit)
 
 
 PARAMETERS: dict[str, tuple[Any, str]] = {

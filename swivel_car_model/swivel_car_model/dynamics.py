@@ -145,8 +145,11 @@ class SwivelMoveResult:
 
 def simulate_swivel_move(p: SwivelCarParams, theta2_target: float, theta2_start: float = 0.0,
                          duration: float = 15.0, samples: int = 1501,
-                         stop_when_settled: bool = False) -> SwivelMoveResult:
-    """Swivel joint driven by the PID from rest at ``theta2_start`` to a step command.
+                         stop_when_settled: bool = False,
+                         max_rate: float = math.inf) -> SwivelMoveResult:
+    """Swivel joint driven by the PID from rest at ``theta2_start`` towards a command that
+    steps to ``theta2_target`` (the thesis' move), or ramps there at ``max_rate`` (the
+    controller's set-point rate limiter).
 
     The target and start must lie on the same side of zero (a move through zero switches the
     steering wheel; split it into two moves). Gains are ``p.kp, p.ki, p.kd``.
@@ -161,10 +164,13 @@ def simulate_swivel_move(p: SwivelCarParams, theta2_target: float, theta2_start:
         Number of output samples (>= 2) over ``duration``.
     stop_when_settled : bool
         End early once ``|theta2 - target| < 1e-6 rad`` and ``|theta2_dot| < 1e-6 rad/s``.
+    max_rate : float
+        Rate limit of the PID's set point; ``inf`` steps it. # [rad/s]
     """
     target = _swivel(p, 'theta2_target', theta2_target)
     start = _swivel(p, 'theta2_start', theta2_start)
     duration = _positive('duration', duration)
+    ramp = _positive('max_rate', max_rate) if max_rate != math.inf else math.inf
     if samples < 2:
         raise ValueError(f'samples must be >= 2, got {samples!r}')
     if target * start < 0.0:
@@ -176,27 +182,36 @@ def simulate_swivel_move(p: SwivelCarParams, theta2_target: float, theta2_start:
     weight = p.mass * GRAVITY * p.l
     front = front_swivel_inertia(p)
 
-    def torque_of(state: np.ndarray) -> float:
-        theta2, rate, integral = state[0], state[1], state[2]
-        return p.kp * (target - theta2) + p.ki * integral - p.kd * rate
+    def set_point(t: float) -> float:
+        if ramp == math.inf:
+            return target
+        reach = ramp * t
+        return start + min(reach, max(-reach, target - start))
 
-    def rhs(_t: float, state: np.ndarray) -> list:
+    def torque_of(t: float, state: np.ndarray) -> float:
+        theta2, rate, integral = state[0], state[1], state[2]
+        return p.kp * (set_point(t) - theta2) + p.ki * integral - p.kd * rate
+
+    def rhs(t: float, state: np.ndarray) -> list:
         theta2, rate = state[0], state[1]
         s = min(max(side * theta2, 0.0), limit)  # |theta2| on this move's side
         slope, curvature = float(d1(s)), float(d2(s))
         inertia = p.inertia * slope * slope + front
         gravity = side * weight * math.cos(float(profile(s)) + p.phi / 2.0) * slope
-        torque = torque_of(state)
+        torque = torque_of(t, state)
+        error = set_point(t) - theta2
         if s == 0.0 and side * (torque - gravity) <= 0.0 and side * rate <= 0.0:
             # At theta2 = 0 the potential has a corner: the joint stays put until the motor
             # torque exceeds the holding torque (the body rests on both front wheels).
-            return [0.0, -rate / _HOLD_TIME, target - theta2, 0.0, 0.0]
+            return [0.0, -rate / _HOLD_TIME, error, 0.0, 0.0]
         # 1/2 J' rate^2 with J' = 2 I_s theta1' theta1'' d|theta2|/d theta2
         accel = (torque - gravity - side * p.inertia * slope * curvature * rate * rate) / inertia
         power = torque * rate
-        return [rate, accel, target - theta2, abs(power), power]
+        return [rate, accel, error, abs(power), power]
 
-    def settled(_t: float, state: np.ndarray) -> float:
+    def settled(t: float, state: np.ndarray) -> float:
+        if set_point(t) != target:
+            return 1.0
         return max(abs(target - state[0]), abs(state[1])) - _SETTLED
 
     settled.terminal = True
@@ -207,7 +222,7 @@ def simulate_swivel_move(p: SwivelCarParams, theta2_target: float, theta2_start:
                     events=settled if stop_when_settled else None)
     if not sol.success:
         raise RuntimeError(f'swivel move integration failed: {sol.message}')
-    torque = np.array([torque_of(sol.y[:, i]) for i in range(sol.y.shape[1])])
+    torque = np.array([torque_of(t, sol.y[:, i]) for i, t in enumerate(sol.t)])
     return SwivelMoveResult(time=sol.t, theta2=sol.y[0], theta2_rate=sol.y[1], torque=torque,
                             energy=sol.y[3], work=sol.y[4],
                             peak_torque=float(np.max(np.abs(torque))),
@@ -215,27 +230,31 @@ def simulate_swivel_move(p: SwivelCarParams, theta2_target: float, theta2_start:
 
 
 @functools.lru_cache(maxsize=256)
-def _climb_cost(p: SwivelCarParams, step_height: float) -> tuple[float, float]:
+def _climb_cost(p: SwivelCarParams, step_height: float,
+                max_rate: float) -> tuple[float, float]:
     theta2 = kinematics.swivel_for_step(p, step_height)
     if theta2 == 0.0:
         return 0.0, 0.0
     # long enough for the PID's integral to wind up to the holding torque of small steps
     move = simulate_swivel_move(p, theta2, duration=_CLIMB_DURATION, samples=6001,
-                                stop_when_settled=True)
+                                stop_when_settled=True, max_rate=max_rate)
     # Part 3 (lifting the body onto the step with the lifted wheel on it) mirrors part 1: the
     # wheel on the step becomes the steering wheel of the same lift constraint.
     return move.peak_torque, 2.0 * move.total_energy
 
 
-def climb_torque_energy(p: SwivelCarParams, step_height: float) -> tuple[float, float]:
+def climb_torque_energy(p: SwivelCarParams, step_height: float,
+                        max_rate: float = math.inf) -> tuple[float, float]:
     """Predicted peak swivel torque and energy of climbing a step (thesis II.C.2, Fig. 31).
 
-    Part 1 lifts the wheel: a PID step move from 0 to ``kinematics.swivel_for_step``, over
-    ``_CLIMB_DURATION`` (the PID's integral must first wind up to the holding torque).
+    Part 1 lifts the wheel: a PID move from 0 to ``kinematics.swivel_for_step``, over
+    ``_CLIMB_DURATION`` (the PID's integral must first wind up to the holding torque); the
+    thesis steps the command (``max_rate`` inf), the controller ramps its set point at
+    ``max_rate`` [rad/s], which keeps the proportional term's kick off the peak.
     Part 3 lifts the body with the wheel resting on the step, modelled as the mirror of part 1
     (same lift constraint with the wheel on the step as the steering wheel), so the energy is
     twice part 1's and the peak the same. Driving (part 2) is not counted. Cached per
-    ``(p, step_height)``.
+    ``(p, step_height, max_rate)``.
 
     Returns
     -------
@@ -246,7 +265,7 @@ def climb_torque_energy(p: SwivelCarParams, step_height: float) -> tuple[float, 
     ValueError
         NaN, negative or out-of-reach step height.
     """
-    return _climb_cost(p, _finite('step_height', step_height))
+    return _climb_cost(p, _finite('step_height', step_height), float(max_rate))
 
 
 # ----------------------------------------------------------------------------------------------

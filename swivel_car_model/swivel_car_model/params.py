@@ -44,6 +44,8 @@ class SwivelCarParams:
         Mass of each wheel, part of ``mass``. # [kg]
     max_swivel_angle : float
         Mechanical limit of the swivel joint, symmetric. # [rad]
+    swivel_torque_limit : float
+        Peak torque of the swivel actuator. # [N m]
 
     Raises
     ------
@@ -63,13 +65,15 @@ class SwivelCarParams:
     wheel_width: float = 0.03  # [m]
     wheel_mass: float = 0.5  # [kg]
     max_swivel_angle: float = math.pi / 2  # [rad]
+    swivel_torque_limit: float = 30.0  # [N m]
 
     def __post_init__(self) -> None:
         for field in fields(self):
             value = getattr(self, field.name)
             if not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise ValueError(f'{field.name} must be a finite number, got {value!r}')
-        for name in ('l', 'h', 'r', 'mass', 'inertia', 'wheel_width', 'wheel_mass'):
+        for name in ('l', 'h', 'r', 'mass', 'inertia', 'wheel_width', 'wheel_mass',
+                     'swivel_torque_limit'):
             if getattr(self, name) <= 0.0:
                 raise ValueError(f'{name} must be > 0, got {getattr(self, name)!r}')
         for name in ('kp', 'ki', 'kd'):

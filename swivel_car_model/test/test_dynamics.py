@@ -61,6 +61,20 @@ def test_joint_stays_at_zero_until_the_pid_beats_the_holding_torque():
     assert move.total_energy == 0.0
 
 
+def test_a_ramped_set_point_takes_the_proportional_kick_off_the_peak():
+    # Gains 150/200/8 (the robot's): a step to 0.3 rad kicks kp * 0.3 = 45 N m at once; at
+    # 0.6 rad/s the set point leads the swivel by little more than the holding torque needs.
+    p = dataclasses.replace(P, kp=150.0, ki=200.0, kd=8.0)
+    stepped = d.simulate_swivel_move(p, 0.3, duration=10.0)
+    ramped = d.simulate_swivel_move(p, 0.3, duration=10.0, max_rate=0.6)
+    assert stepped.peak_torque == pytest.approx(45.0, rel=1e-3)
+    holding = float(d.swivel_gravity_torque(p, 1e-12))
+    assert holding <= ramped.peak_torque < 1.3 * holding
+    assert ramped.theta2[-1] == pytest.approx(0.3, abs=1e-3)
+    assert d.climb_torque_energy(p, 0.08, 0.6)[0] == pytest.approx(ramped.peak_torque,
+                                                                   rel=0.1)
+
+
 def test_climb_cost_covers_the_holding_torque_and_twice_the_lift_work():
     peak, energy = d.climb_torque_energy(P, 0.05)
     assert peak >= d.swivel_gravity_torque(P, 1e-12)

@@ -20,16 +20,12 @@ def generate_launch_description() -> LaunchDescription:
                               description='planner parameter file'),
         DeclareLaunchArgument('use_sim_time', default_value='true',
                               description='run on the sim clock (/clock)'),
-        DeclareLaunchArgument('torque_limit', default_value='30.0',
-                              description='swivel actuator peak torque [N m]'),
         Node(
             package='swivel_car_planner', executable='planner_node', name='planner',
             namespace=LaunchConfiguration('namespace'), output='screen',
             parameters=[
                 LaunchConfiguration('params_file'),
                 {'use_sim_time': ParameterValue(LaunchConfiguration('use_sim_time'),
-                                                value_type=bool),
-                 'torque_limit': ParameterValue(LaunchConfiguration('torque_limit'),
-                                                value_type=float)},
+                                                value_type=bool)},
             ]),
     ])

@@ -119,7 +119,7 @@ class PlannerNode(Node):
         self.create_timer(self._ready_timeout / 4.0, self._check_inputs_alive)
         self.get_logger().info(
             f'planner ready: model max scalable step {self._max_step():.3f} m, torque limit '
-            f'{self.config.torque_limit:.1f} N m')
+            f'{self.robot.swivel_torque_limit:.1f} N m')
 
     def _positive_parameter(self, name: str, default: float, description: str) -> float:
         value = float(self.declare_parameter(
@@ -146,7 +146,7 @@ class PlannerNode(Node):
             self.get_logger().warning(
                 f'the capability table {path} was measured on another robot description; '
                 'its limit may not hold for this one (regenerate it: python -m '
-                'swivel_car_planner.benchmark --write-capability)')
+                'swivel_car_bringup.climb_benchmark --write-capability)')
         self.get_logger().info(f'whole-car limit {table.limit:.3f} m (success >= '
                                f'{table.reliable:.0%} in {path})')
         return table.limit

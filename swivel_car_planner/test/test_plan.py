@@ -40,8 +40,8 @@ def test_feasible_plan_clears_the_step_and_keeps_the_rules():
     assert plan.lift_angle == pytest.approx(kinematics.lift_angle(P, plan.swivel_angle))
     assert plan.tip_over_margin >= CONFIG.tip_over_margin
     assert plan.interference_margin > 0.0
-    assert plan.peak_torque <= CONFIG.torque_limit
-    peak, energy = dynamics.climb_torque_energy(P, 0.05)
+    assert plan.peak_torque <= P.swivel_torque_limit
+    peak, energy = dynamics.climb_torque_energy(P, 0.05, CONFIG.swivel_rate)
     assert (plan.peak_torque, plan.energy) == pytest.approx((peak, energy))
     assert plan.duration > 0.0
     assert plan.max_scalable_step == pytest.approx(kinematics.max_scalable_step(P)[0])
@@ -88,7 +88,8 @@ def test_step_above_the_measured_whole_car_limit_is_refused_with_the_limit():
 
 
 def test_plan_only_makes_exactly_the_checks_of_a_real_call():
-    for kwargs in (dict(height=WHOLE_CAR_LIMIT + 0.01), dict(distance=0.1),
+    no_backup = dataclasses.replace(CONFIG, max_backup=0.0)
+    for kwargs in (dict(height=WHOLE_CAR_LIMIT + 0.01), dict(distance=0.1, config=no_backup),
                    dict(width=0.3)):
         real = refusal(whole_car_limit=WHOLE_CAR_LIMIT, **kwargs)
         planned = refusal(whole_car_limit=WHOLE_CAR_LIMIT, plan_only=True, **kwargs)
@@ -118,7 +119,7 @@ def test_tip_over_margin_refuses_a_plan_that_would_pitch_too_far():
 
 
 def test_torque_limit_refuses_a_plan_the_actuator_cannot_do():
-    error = refusal(config=dataclasses.replace(FRONT, torque_limit=0.01), height=0.05)
+    error = refusal(p=dataclasses.replace(P, swivel_torque_limit=0.01), height=0.05)
     assert error.code == ErrorCode.TORQUE_LIMIT
     assert 'N m' in error.message
 
@@ -126,17 +127,38 @@ def test_torque_limit_refuses_a_plan_the_actuator_cannot_do():
 def test_wheel_interference_refuses_a_long_shaft_on_a_short_body():
     # Long shafts on short columns: at a 2 cm step the steering wheel's shaft reaches back
     # over the rear axle (eq. 75 margin about -0.07 m) while the tip-over rule still holds.
-    p = SwivelCarParams(l=0.05, h=0.3, r=0.03, phi=1.4, wheel_width=0.02)
-    error = refusal(p=p, config=dataclasses.replace(FRONT, torque_limit=1e6), height=0.02,
+    p = SwivelCarParams(l=0.05, h=0.3, r=0.03, phi=1.4, wheel_width=0.02,
+                        swivel_torque_limit=1e6)
+    error = refusal(p=p, height=0.02,
                     distance=3.0)
     assert error.code == ErrorCode.WHEEL_INTERFERENCE
     assert 'eq. 75' in error.message
 
 
-def test_step_too_close_to_align_is_invalid():
-    error = refusal(config=FRONT, height=0.05, distance=0.1)
+def test_step_too_close_to_align_is_invalid_without_room_to_back_up():
+    error = refusal(config=dataclasses.replace(FRONT, max_backup=0.0), height=0.05,
+                    distance=0.1)
     assert error.code == ErrorCode.INVALID_REQUEST
     assert 'too close' in error.message
+    error = refusal(config=dataclasses.replace(FRONT, max_backup=0.2), height=0.05,
+                    distance=0.1, yaw=0.3)
+    assert 'too close' in error.message and 'max_backup' in error.message
+
+
+@pytest.mark.parametrize('yaw, width', [(0.0, 0.0), (0.3, 0.0), (-0.3, 2.0)])
+def test_a_close_step_is_planned_from_the_least_backup_that_makes_room(yaw, width):
+    near = make_plan(P, CONFIG, request(0.05, distance=0.2, yaw=yaw, width=width))
+    assert 0.0 < near.backup_distance <= CONFIG.max_backup
+    # The plan is the one of the same step asked from where the backup ends...
+    backed = make_plan(P, CONFIG, request(0.05, distance=0.2 + near.backup_distance,
+                                          yaw=yaw, width=width))
+    assert backed.backup_distance == 0.0
+    assert (backed.approach_heading, backed.crossing) == (near.approach_heading, near.crossing)
+    # ...and one increment less would not do.
+    shorter = near.backup_distance - 0.05
+    with pytest.raises(PlanError, match='too close'):
+        make_plan(P, dataclasses.replace(CONFIG, max_backup=0.0),
+                  request(0.05, distance=0.2 + shorter, yaw=yaw, width=width))
 
 
 def test_without_a_width_the_approach_only_holds_its_heading():
@@ -190,7 +212,7 @@ def test_every_plan_keeps_its_margins_or_says_why_not(height, yaw):
         return
     assert plan.wheel_clearance >= FRONT.clearance_margin - 1e-9
     assert plan.tip_over_margin >= FRONT.tip_over_margin
-    assert plan.peak_torque <= FRONT.torque_limit
+    assert plan.peak_torque <= P.swivel_torque_limit
     assert math.isfinite(plan.duration) and plan.duration > 0.0
     assert plan.lifted_side * plan.swivel_angle > 0.0
     assert abs(plan.lead_angle) >= climbing.min_approach_angle_for_step(P, height) - 1e-12

@@ -323,8 +323,8 @@ def test_bad_parameter_is_a_clear_error_at_start():
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=next_domain_id())
     try:
-        with pytest.raises(ValueError, match='torque_limit'):
+        with pytest.raises(ValueError, match='climb_speed'):
             PlannerNode(context=context,
-                        parameter_overrides=[Parameter('torque_limit', value=-1.0)])
+                        parameter_overrides=[Parameter('climb_speed', value=-1.0)])
     finally:
         rclpy.shutdown(context=context)

@@ -13,11 +13,11 @@ GOOD = dict(step_height=0.05, step_distance=1.0, step_yaw=0.1)
 
 
 def test_default_config_is_valid():
-    assert CONFIG.torque_limit > 0.0
+    assert CONFIG.swivel_rate > 0.0
 
 
 @pytest.mark.parametrize('name, value', [
-    ('torque_limit', math.nan), ('clearance_margin', -0.01), ('swivel_rate', 0.0),
+    ('climb_speed', math.nan), ('clearance_margin', -0.01), ('swivel_rate', 0.0),
     ('max_step_yaw', math.pi / 2), ('time_allowance', math.inf), ('stall_time', True),
     ('stop_speed', 0.0), ('stop_speed', math.nan)])
 def test_bad_config_names_the_field(name, value):

@@ -57,6 +57,32 @@ def test_climb_goes_through_every_phase_and_ends_with_all_wheels_past_the_edge(y
     assert machine.outcome.energy > 0.0
 
 
+def test_a_step_too_close_to_turn_backs_up_straight_then_approaches():
+    machine, plan = start(distance=0.25)
+    assert plan.backup_distance > 0.0
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: c.commands and m.step == Step.APPROACH)
+    assert machine.step == Step.APPROACH
+    assert car.odometry.x <= -plan.backup_distance + 1e-9  # straight back along x
+    assert abs(car.odometry.y) < 0.01
+    assert all(c.drive_speed < 0.0 and c.angle == 0.0 for c in car.commands[:-1])
+    run(machine, car, until=lambda m, c: m.phase == Phase.LIFT)
+    assert machine.outcome is None and machine.phase == Phase.LIFT
+
+
+def test_the_climb_ends_only_once_the_car_stands_on_top():
+    machine, _ = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.step == Step.STOP_ON_TOP)
+    assert machine.outcome is None
+    assert car.commands[-1].drive_speed == 0.0 and car.commands[-1].hold
+    speeds = []
+    run(machine, car, until=lambda m, c: speeds.append(c.observe().speed))
+    assert machine.outcome.success
+    assert abs(speeds[-1]) <= CONFIG.stop_speed
+    assert car.commands[-2].drive_speed == 0.0 and car.commands[-2].hold
+
+
 def test_lift_starts_at_the_planned_distance_and_heading():
     machine, plan = start(yaw=0.2)
     car = KinematicCar()

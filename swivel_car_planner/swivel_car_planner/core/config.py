@@ -27,10 +27,11 @@ class PlannerConfig:
         0.15, 'margin the plan keeps on the tip-over rule (pi - phi)/2 - theta1 [rad]')
     clearance_margin: float = _field(
         0.01, 'lifted wheel lowest point above the step top [m]')
-    torque_limit: float = _field(
-        30.0, 'peak torque of the swivel actuator (the controller max_torque) [N m]')
     max_step_distance: float = _field(3.0, 'farthest step edge a request may name [m]')
     max_step_yaw: float = _field(1.0, 'largest |step_yaw| the planner accepts [rad]')
+    max_backup: float = _field(
+        1.0, 'a step too close to turn onto the approach: the car first backs up straight, '
+        'at most this far (what is behind it is not checked); 0: refuse instead [m]')
     lead_margin: float = _field(
         0.03, 'lifted wheel past the edge while the other front wheel is still clear [m]')
     lift_gap: float = _field(0.03, 'lifted wheel front to the riser when the lift starts [m]')
@@ -61,8 +62,14 @@ class PlannerConfig:
         'crossing of the edge [rad/m]')
     rest_margin: float = _field(
         0.05, 'rear wheel contacts past the edge to call the climb done [m]')
+    stop_allowance: float = _field(
+        0.3, 'travel on the top face after the rear wheels are rest_margin past the edge: '
+        'they leave the riser at speed, the car comes level, then stops [m]')
     level_tolerance: float = _field(
-        0.12, 'largest |pitch| on top of the step to call the climb done [rad]')
+        0.12, 'largest |pitch| that counts as level while the rear axle climbs [rad]')
+    rest_tolerance: float = _field(
+        0.05, 'largest |pitch| (and twice that |roll|) of the car standing on top to call '
+        'the climb done [rad]')
     bias_gain: float = _field(
         2.0, 'outer loop: command bias per remaining swivel error and second [1/s]')
     max_bias: float = _field(0.6, 'outer loop: largest command bias [rad]')
@@ -71,7 +78,9 @@ class PlannerConfig:
         0.01, 'the swivel must close on its goal by this much every stall_time [rad]')
     stall_time: float = _field(4.0, 'swivel making no headway this long: stall [s]')
     slip_yaw_tolerance: float = _field(
-        0.25, 'IMU and odometry headings parting this far: the wheels slip [rad]')
+        0.6, 'IMU and odometry headings parting this far while the rear axle climbs: the '
+        'wheels slip (locked differentials scrub: on climbs that ended on top in the sim '
+        'they parted by more than 0.25 rad) [rad]')
     no_progress_time: float = _field(4.0, 'window of the no-progress monitor [s]')
     min_progress: float = _field(0.01, 'path length the car must make in that window [m]')
     pitch_abort_margin: float = _field(
@@ -86,7 +95,7 @@ class PlannerConfig:
                 raise ValueError(f'{item.name} must be a finite number, got {value!r}')
             if value < 0.0:
                 raise ValueError(f'{item.name} must be >= 0, got {value!r}')
-        for name in ('torque_limit', 'max_step_distance', 'max_step_yaw', 'max_lead_angle',
+        for name in ('max_step_distance', 'max_step_yaw', 'max_lead_angle',
                      'approach_speed', 'climb_speed', 'rear_speed', 'swivel_rate', 'max_steer',
                      'max_swivel_command', 'swivel_tolerance', 'settle_rate', 'stop_speed',
                      'stall_progress',

@@ -34,6 +34,7 @@ rising wheel into the riser.
 from __future__ import annotations
 
 import math
+import dataclasses
 from dataclasses import dataclass
 
 from swivel_car_model import climbing, dynamics, kinematics
@@ -84,6 +85,8 @@ class ClimbPlan:
     # point the request's x axis meets it; None: the step's extent is not known, the approach
     # only holds its heading
     crossing: float | None = None
+    # [m] the car first backs up this far, straight, to make room for the approach
+    backup_distance: float = 0.0
 
 
 def lead_angle(p: SwivelCarParams, config: PlannerConfig, step_height: float) -> float:
@@ -111,12 +114,13 @@ def crossing_range(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequ
     """Where along the edge the car's centre line may cross it so that every wheel that is on
     the step stays on its top face, ``edge_margin`` inside its sides, while the car drives on
     at ``heading`` (to the normal) until the trailing rear wheel is ``rest_margin`` past the
-    edge. Along the edge leftwards from where the request's x axis meets it; empty (low >
+    edge and then ``stop_allowance`` further until it stands. Along the edge leftwards from where the request's x axis meets it; empty (low >
     high) when the face is too narrow. # [m]"""
     sine, cosine = math.sin(heading), math.cos(heading)
     # Along the heading from the crossing, the wheels on top lie between the rear axle at
     # the crossing and the front axle once the trailing rear wheel is rest_margin past.
-    reach = (config.rest_margin + p.h * abs(sine)) / cosine + p.wheelbase  # [m]
+    reach = ((config.rest_margin + p.h * abs(sine)) / cosine + config.stop_allowance
+             + p.wheelbase)  # [m]
     half = p.h * cosine + p.wheel_width / 2.0 + config.edge_margin
     low = request.step_offset - request.step_width / 2.0 + half - min(0.0, sine * reach)
     high = request.step_offset + request.step_width / 2.0 - half - max(0.0, sine * reach)
@@ -243,11 +247,12 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
         raise PlanError(ErrorCode.WHEEL_INTERFERENCE,
                         f'at the lift angle {theta1:.3f} rad the front wheel shaft reaches the '
                         f'rear wheels (eq. 75 margin {interference:.3f} m)')
-    peak_torque, energy = (float(v) for v in dynamics.climb_torque_energy(p, height))
-    if peak_torque > config.torque_limit:
+    peak_torque, energy = (float(v) for v in dynamics.climb_torque_energy(
+        p, height, config.swivel_rate))
+    if peak_torque > p.swivel_torque_limit:
         raise PlanError(ErrorCode.TORQUE_LIMIT,
                         f'the climb needs a peak swivel torque of {peak_torque:.2f} N m, above '
-                        f'the actuator limit of {config.torque_limit:.2f} N m')
+                        f'the actuator limit of {p.swivel_torque_limit:.2f} N m')
 
     # Lift the wheel on the side that leads already, so the car turns the least; with the
     # step's extent known, on the side whose natural crossing of the edge lies nearer the
@@ -255,10 +260,23 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
     initial_heading = -request.step_yaw  # [rad] car heading to the edge's normal
     leading = 1 if initial_heading <= 0.0 else -1
     sides = (leading, -leading) if request.step_width > 0.0 else (leading,)
-    approaches = [_approach(p, config, request, theta2, side) for side in sides]
-    approach = min(approaches, key=lambda a: (a.error is not None, a.shift, a.side != leading))
-    if approach.error is not None:
-        raise PlanError(ErrorCode.INVALID_REQUEST, approach.error)
+    # Too close to turn onto the approach (or onto the crossing): backing up straight along
+    # the car's x axis gives the same request with the edge further ahead.
+    requested = request
+    for backup in _backups(config.max_backup):
+        request = dataclasses.replace(requested, step_distance=requested.step_distance + backup)
+        approaches = [_approach(p, config, request, theta2, side) for side in sides]
+        approach = min(approaches,
+                       key=lambda a: (a.error is not None, a.shift, a.side != leading))
+        if approach.error is None:
+            break
+        if backup == 0.0:
+            first_error = approach.error
+    else:
+        raise PlanError(ErrorCode.INVALID_REQUEST,
+                        first_error if config.max_backup == 0.0 else
+                        f'{first_error}; backing up {config.max_backup:.2f} m (max_backup) '
+                        f'does not make room either')
     available = request.step_distance * math.cos(request.step_yaw)
     side, psi_lead, approach_heading = approach.side, approach.lead, approach.heading
     lead_distance, axle_normal = approach.lead_distance, approach.axle_normal
@@ -268,7 +286,7 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
     v_approach = config.approach_speed * p.r  # [m/s]
     v_climb = config.climb_speed * p.r  # [m/s]
     cos_lead = math.cos(psi_lead)
-    duration = (max(0.0, available - axle_normal) / max(0.5, cos_lead) / v_approach
+    duration = ((backup + max(0.0, available - axle_normal) / max(0.5, cos_lead)) / v_approach
                 + 2.0 * abs(theta2) / config.swivel_rate + config.settle_time
                 + (lead_distance + config.lead_margin) / cos_lead / v_climb
                 + (p.wheelbase + 2.0 * p.h * abs(math.sin(psi_lead)) + config.rest_margin)
@@ -283,4 +301,15 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
         lifted_side=side, lead_angle=psi_lead, lead_distance=lead_distance,
         second_swivel_angle=-side * float(kinematics.swivel_for_step(
             p, config.clearance_margin, respect_tip_over=False)),
-        step_height=height, crossing=approach.crossing)
+        step_height=height, crossing=approach.crossing, backup_distance=backup)
+
+
+_BACKUP_INCREMENT = 0.05  # [m]
+
+
+def _backups(max_backup: float) -> list[float]:
+    """Backup distances to try, shortest first: 0, then in increments up to ``max_backup``
+    [m]."""
+    count = int(math.floor(max_backup / _BACKUP_INCREMENT + 1e-9))
+    return [0.0] + [i * _BACKUP_INCREMENT for i in range(1, count + 1)] + (
+        [max_backup] if max_backup > count * _BACKUP_INCREMENT + 1e-9 else [])

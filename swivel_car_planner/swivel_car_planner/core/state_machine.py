@@ -6,6 +6,9 @@ action phase each one reports)::
     STOP             only if the car is moving when asked: drive 0, the swivel
                      held, until odometry says it stands (the edge stays where
                      the request put it, relative to the car when asked)       APPROACH
+    BACK_UP          only if the plan says so (the step is too close to turn
+                     onto the approach): reverse straight, the swivel at 0,
+                     until the car is ``plan.backup_distance`` back            APPROACH
     APPROACH         drive to the lift point, steering to the planned heading   APPROACH
     LIFT             stop; swivel to the plan's angle: the leading front wheel
                      rises above the step                                       LIFT
@@ -18,6 +21,8 @@ action phase each one reports)::
     REAR             drive, holding the lead heading, until the rear wheels are
                      past the edge and the car is level; the rear axle has no
                      lift, it climbs by traction only                           CLIMB_REST
+    STOP_ON_TOP      drive 0, the swivel held where it is, until odometry says
+                     the car stands; done if it is still level                  CLIMB_REST
 
 Every step but APPROACH wants the *measured* swivel at an angle. Under load (a wheel lifted,
 or the front of the car lifted with one wheel on the step) the controller's PID settles short
@@ -61,6 +66,7 @@ class Step(Enum):
     """Internal steps of the climb: (action phase, share of the progress at its start)."""
 
     STOP = (Phase.APPROACH, 0.0)
+    BACK_UP = (Phase.APPROACH, 0.02)
     APPROACH = (Phase.APPROACH, 0.05)
     LIFT = (Phase.LIFT, 0.2)
     ADVANCE = (Phase.ADVANCE, 0.3)
@@ -68,6 +74,7 @@ class Step(Enum):
     SECOND_ADVANCE = (Phase.CLIMB_REST, 0.5)
     SECOND_SET_DOWN = (Phase.CLIMB_REST, 0.6)
     REAR = (Phase.CLIMB_REST, 0.65)
+    STOP_ON_TOP = (Phase.CLIMB_REST, 0.95)
     DONE = (Phase.DONE, 1.0)
 
     @property
@@ -80,7 +87,7 @@ class Step(Enum):
 
 
 _STEPS = list(Step)
-_DRIVING = (Step.APPROACH, Step.ADVANCE, Step.SECOND_ADVANCE, Step.REAR)
+_DRIVING = (Step.BACK_UP, Step.APPROACH, Step.ADVANCE, Step.SECOND_ADVANCE, Step.REAR)
 
 
 @dataclass(frozen=True)
@@ -163,6 +170,7 @@ class ClimbStateMachine:
                           0.5 * math.asin(min(1.0, plan.step_height / p.wheelbase)))
         self._step = Step.APPROACH
         self._edge: StepEdge | None = None
+        self._origin = Pose2D(0.0, 0.0, 0.0)  # odometry pose when the climb was asked
         self._start_time = 0.0  # [s]
         self._last: Observation | None = None
         self._path = 0.0  # [m]
@@ -233,8 +241,12 @@ class ClimbStateMachine:
         step = self._step
         if step == Step.STOP:
             if abs(obs.speed) <= config.stop_speed:
-                return self._enter(Step.APPROACH, obs)
+                return self._enter(self._first_move(), obs)
             return Command(self._last_command, config.swivel_rate, 0.0, True)
+        if step == Step.BACK_UP:
+            if self._backed_up(obs) >= plan.backup_distance:
+                return self._enter(Step.APPROACH, obs)
+            return Command(0.0, config.swivel_rate, -config.approach_speed, True)
         if step == Step.APPROACH:
             if self._lifted_wheel_distance(obs) >= -plan.lead_distance:
                 error = plan.approach_heading - self._edge.relative_heading(self._heading(obs))
@@ -267,6 +279,19 @@ class ClimbStateMachine:
             if self._settled(obs, 0.0):
                 return self._enter(Step.REAR, obs)
             return self._hold(obs, 0.0, 0.0)
+        if step == Step.STOP_ON_TOP:
+            if abs(obs.speed) > config.stop_speed:
+                return Command(self._last_command, config.swivel_rate, 0.0, True)
+            # Roll gets twice the pitch's tolerance: the held swivel twists the car a little.
+            rest = config.rest_tolerance
+            if abs(obs.pitch) > rest or abs(obs.roll) > 2.0 * rest:
+                return self._finish(
+                    obs, ErrorCode.FAILED,
+                    f'the car came to rest pitched {obs.pitch:.3f} rad, rolled '
+                    f'{obs.roll:.3f} rad after the rear wheels passed the edge: a wheel is '
+                    f'not on top')
+            return self._finish(obs, ErrorCode.NONE,
+                                'climbed: all four wheels on top of the step, at rest')
         # REAR
         rear = self._rear_wheel_distance(obs)
         level = abs(obs.pitch) <= self._level
@@ -280,8 +305,10 @@ class ClimbStateMachine:
                 f'the front wheels came down off the step while the rear axle was still '
                 f'{-rear:.2f} m short of the edge')
         if rear >= config.rest_margin and level:
-            return self._finish(obs, ErrorCode.NONE,
-                                'climbed: all four wheels on top of the step')
+            # The rear wheels leave the riser at speed: stop on the top face before calling
+            # it done, the swivel held so the car neither turns nor twists a wheel up.
+            self._last_command = obs.swivel
+            return self._enter(Step.STOP_ON_TOP, obs)
         if rear >= config.rest_margin + config.rear_slip_allowance:
             return self._finish(
                 obs, ErrorCode.FAILED,
@@ -289,6 +316,16 @@ class ClimbStateMachine:
                 f'puts it {rear:.2f} m past the edge while the pitch is still {obs.pitch:.3f} '
                 f'rad (the rear wheels slip; they climb by traction only)')
         return self._steer(obs, plan.lead_angle, config.rear_speed)
+
+    def _first_move(self) -> Step:
+        return Step.BACK_UP if self._plan.backup_distance > 0.0 else Step.APPROACH
+
+    def _backed_up(self, obs: Observation) -> float:
+        """How far the car is behind where the climb was asked, along its x axis then. # [m]
+        """
+        origin = self._origin
+        return -((obs.x - origin.x) * math.cos(origin.yaw)
+                 + (obs.y - origin.y) * math.sin(origin.yaw))
 
     def _approach_heading(self, obs: Observation) -> float:
         """The planned approach heading, corrected towards the planned crossing of the edge
@@ -346,22 +383,27 @@ class ClimbStateMachine:
 
     def _enter(self, step: Step, obs: Observation) -> Command:
         """Switch to ``step`` and return its first command."""
+        self._switch(step, obs)
+        return self._advance(obs)
+
+    def _switch(self, step: Step, obs: Observation) -> None:
         self._step = step
         self._progress_ref = (obs.time, self._path)
         self._at_rest_since = None
         self._stall_ref = (obs.time, math.inf)
         plan, config = self._plan, self._config
         spans = {
+            Step.BACK_UP: (self._backed_up(obs), plan.backup_distance),
             Step.APPROACH: (self._lifted_wheel_distance(obs), -plan.lead_distance),
             Step.LIFT: (obs.swivel, plan.swivel_angle),
             Step.ADVANCE: (self._lifted_wheel_distance(obs), config.lead_margin),
             Step.SET_DOWN: (obs.swivel, plan.second_swivel_angle),
             Step.SECOND_ADVANCE: (self._second_wheel_distance(obs), config.lead_margin),
             Step.SECOND_SET_DOWN: (obs.swivel, 0.0),
-            Step.REAR: (self._rear_wheel_distance(obs), config.rest_margin)}
+            Step.REAR: (self._rear_wheel_distance(obs), config.rest_margin),
+            Step.STOP_ON_TOP: (abs(obs.speed), 0.0)}
         self._span = spans.get(step, (0.0, 1.0))
         self._slip_ref = wrap_angle(self._heading(obs) - obs.yaw)
-        return self._advance(obs)
 
     # --- geometry -------------------------------------------------------------------------
 
@@ -390,8 +432,10 @@ class ClimbStateMachine:
                    self._wheel_distance(obs, 0.0, -self._p.h))
 
     def _progress_quantity(self, obs: Observation) -> float:
-        if self._step == Step.STOP:
+        if self._step in (Step.STOP, Step.STOP_ON_TOP):
             return abs(obs.speed)
+        if self._step == Step.BACK_UP:
+            return self._backed_up(obs)
         if self._step in (Step.APPROACH, Step.ADVANCE):
             return self._lifted_wheel_distance(obs)
         if self._step == Step.SECOND_ADVANCE:
@@ -406,6 +450,7 @@ class ClimbStateMachine:
         self._edge = StepEdge.from_request(Pose2D(obs.x, obs.y, obs.yaw), self._p.wheelbase,
                                            self._step_distance, self._step_yaw)
         self._start_time = obs.time
+        self._origin = Pose2D(obs.x, obs.y, obs.yaw)
         self._yaw_offset = obs.imu_yaw - obs.yaw
         self._progress_ref = (obs.time, 0.0)
         self._stall_ref = (obs.time, math.inf)
@@ -414,8 +459,7 @@ class ClimbStateMachine:
             self._last_command = obs.swivel
             self._span = (abs(obs.speed), 0.0)
         else:
-            self._step = Step.APPROACH
-            self._span = (self._lifted_wheel_distance(obs), -self._plan.lead_distance)
+            self._switch(self._first_move(), obs)
 
     def _measure(self, obs: Observation) -> None:
         if self._last is not None:

@@ -1,0 +1,266 @@
+"""Whole-car climbing benchmark in physics: ``python -m swivel_car_bringup.climb_benchmark``.
+
+Climbs steps from 2 to 20 cm in 1 cm increments, each from randomised requests (distance from
+the front axle to the edge, the edge's yaw, the top face's width and where along the edge it
+lies), through the in-process stack (``InProcessStack``: the sim, controller, odometry and
+planner cores of the ROS nodes, in lockstep), and prints a table judged by the sim's ground
+truth: the front axle on top (the thesis' criterion) and all four wheels on top, level, at
+rest. Beside them the swivel torque (peak, measured and predicted by the model; sign changes
+while the rear axle climbs, the chatter of the old procedure), the energy, and the car-like
+baseline with the same mass layout and drive train driven straight at the same steps.
+
+Requests the planner refuses before moving because of where the car stands (the top face
+too narrow for the crossing the car can reach from there) are drawn again and reported, not
+counted: they say nothing about how high the car climbs. ``--write-capability`` writes the
+planner's capability table (``swivel_car_planner/config/capability.yaml``). About 3 s of wall
+time per climb; prints, asserts nothing.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections import defaultdict
+from dataclasses import dataclass
+import math
+from pathlib import Path
+import random
+import shlex
+import statistics
+import sys
+import time
+
+import numpy as np
+import yaml
+
+from swivel_car_model import kinematics
+from swivel_car_model.description import CarDescription
+from swivel_car_planner.core import ClimbRequest, ErrorCode
+from swivel_car_planner.core.capability import CapabilityTable, description_values, RELIABLE
+
+from swivel_car_bringup.inprocess import InProcessStack
+
+_NOT_ATTEMPTED = (ErrorCode.INVALID_REQUEST,)
+_REFUSED = (ErrorCode.UNREACHABLE_HEIGHT, ErrorCode.TIP_OVER, ErrorCode.TORQUE_LIMIT,
+            ErrorCode.WHEEL_INTERFERENCE)
+_CHATTER_TORQUE = 1.0  # [N m] torque sign changes count between values beyond +-this
+_CAR_LIKE_SPEED = 0.5  # [m/s] the baseline's drive speed at the step
+_CAR_LIKE_TIME = 6.0  # [s] sim time it drives
+
+
+@dataclass(frozen=True)
+class Trial:
+    height: float  # [m]
+    distance: float  # [m]
+    yaw: float  # [rad]
+    width: float  # [m]
+    offset: float  # [m]
+    code: ErrorCode
+    message: str
+    front: bool  # ground truth: the front axle on top
+    four: bool  # ground truth: all four wheels on top, level
+    peak_torque: float  # [N m] measured: the controller's commanded swivel torque
+    energy: float  # [J] measured
+    predicted_torque: float  # [N m] model
+    predicted_energy: float  # [J] model
+    rear_sign_changes: int  # swivel torque sign changes while the rear axle climbs
+    rear_peak_torque: float  # [N m] while the rear axle climbs
+    backup: float  # [m] the car backed up first this far
+
+
+def heights(start: float, stop: float, step: float) -> list[float]:
+    count = int(round((stop - start) / step))
+    return [round(start + i * step, 4) for i in range(count + 1)]
+
+
+def sign_changes(torque: np.ndarray, threshold: float = _CHATTER_TORQUE) -> int:
+    """Sign changes of ``torque`` [N m] between values beyond +-``threshold``."""
+    signs = np.sign(torque[np.abs(torque) > threshold])
+    return int(np.count_nonzero(signs[1:] != signs[:-1]))
+
+
+def run_swivel(args: argparse.Namespace, robot: dict, rng: random.Random) -> list[Trial]:
+    trials = []
+    with InProcessStack(robot=robot, planner={'capability_file': 'none'}) as stack:
+        for height in heights(args.min_height, args.max_height, args.step):
+            attempted = drawn = 0
+            while attempted < args.trials and drawn < args.trials * args.max_draws:
+                drawn += 1
+                distance = rng.uniform(args.min_distance, args.max_distance)
+                yaw = rng.uniform(-args.max_yaw, args.max_yaw)
+                width = rng.uniform(args.min_width, args.max_width)
+                offset = rng.uniform(-args.max_offset, args.max_offset)
+                stack.reset()
+                stack.settle(0.2)
+                stack.spawn_step(height, distance, yaw, width=width, depth=3.0)
+                result = stack.climb(ClimbRequest(
+                    step_height=height, step_distance=distance, step_yaw=yaw,
+                    step_width=width, step_offset=offset))
+                if result.error_code not in _NOT_ATTEMPTED:
+                    attempted += 1
+                stack.settle(1.0)
+                rear = result.trajectory.between(*result.step_window('REAR'))
+                outcome, plan = result.outcome, result.plan
+                trial = Trial(
+                    height, distance, yaw, width, offset, result.error_code, result.message,
+                    stack.front_on_top(height), stack.four_wheels_on_top(height),
+                    outcome.peak_torque if outcome else 0.0,
+                    outcome.energy if outcome else 0.0,
+                    plan.peak_torque if plan else math.nan,
+                    plan.energy if plan else math.nan,
+                    sign_changes(rear.swivel_torque),
+                    float(np.max(np.abs(rear.swivel_torque), initial=0.0)),
+                    plan.backup_distance if plan else 0.0)
+                trials.append(trial)
+                print(f'  {height:.2f} m  d {distance:.2f} m  yaw {yaw:+.2f} rad  width '
+                      f'{width:.2f} m  offset {offset:+.2f} m  backup {trial.backup:.2f} m: '
+                      f'{trial.code.name:<18} front '
+                      f'{"up" if trial.front else "--"}  four {"up" if trial.four else "--"}'
+                      f'  ({result.message})', flush=True)
+    return trials
+
+
+def run_car_like(args: argparse.Namespace, robot: dict) -> dict[float, bool]:
+    """Drive the car-like baseline straight at each step; True where all four wheels end on
+    top. Stops after two heights in a row fail (higher ones only fail the more)."""
+    results: dict[float, bool] = {}
+    with InProcessStack('car_like', robot=robot) as stack:
+        for height in heights(args.min_height, args.max_height, args.step):
+            stack.reset()
+            stack.settle(0.2)
+            stack.spawn_step(height, 0.3, depth=10.0)  # deep: it must not drive off the far side
+            stack.drive(_CAR_LIKE_SPEED, 0.0, _CAR_LIKE_TIME)
+            stack.drive(0.0, 0.0, 1.0)
+            results[height] = stack.four_wheels_on_top(height)
+            print(f'  car-like {height:.2f} m: {"on top" if results[height] else "stopped"}',
+                  flush=True)
+            if len(results) >= 2 and not any(list(results.values())[-2:]):
+                break
+    return results
+
+
+def table_of(trials: list[Trial], judge, description: CarDescription,
+             command: str) -> CapabilityTable:
+    """Success of the attempted climbs by height, judged by ``judge(trial)``."""
+    by_height: dict[float, list[Trial]] = defaultdict(list)
+    for trial in trials:
+        if trial.code not in _NOT_ATTEMPTED:
+            by_height[trial.height].append(trial)
+    ordered = sorted(by_height)
+    return CapabilityTable(
+        tuple(ordered), tuple(len(by_height[h]) for h in ordered),
+        tuple(sum(bool(judge(t)) for t in by_height[h]) for h in ordered),
+        description_values(description), command=command)
+
+
+def report(trials: list[Trial], car_like: dict[float, bool],
+           description: CarDescription) -> None:
+    p = description.model_params()
+    by_height: dict[float, list[Trial]] = defaultdict(list)
+    for trial in trials:
+        by_height[trial.height].append(trial)
+    print()
+    print('height | n | not attempted | front up | 4 wheels | peak torque meas / model | '
+          'energy meas / model | rear: torque sign changes, peak | car-like | typical failure')
+    print('-------|---|---------------|----------|----------|--------------------------|'
+          '---------------------|----------------------------------|----------|----------------')
+    for height, drawn in sorted(by_height.items()):
+        group = [t for t in drawn if t.code not in _NOT_ATTEMPTED]
+        skipped = len(drawn) - len(group)
+        car = {True: 'on top', False: 'stopped', None: '-'}[car_like.get(height)]
+        if not group:
+            print(f'{height:.2f} m | 0 | {skipped:13d} | every request refused as placed | '
+                  f'{car}')
+            continue
+        n = len(group)
+        climbed = [t for t in group if t.code not in _REFUSED]
+        if climbed:
+            torque = (f'{max(t.peak_torque for t in climbed):5.1f} / '
+                      f'{climbed[0].predicted_torque:5.1f} N m')
+            energy = (f'{statistics.mean(t.energy for t in climbed):5.1f} / '
+                      f'{climbed[0].predicted_energy:5.1f} J')
+            rear = (f'{statistics.median(t.rear_sign_changes for t in climbed):4.0f}, '
+                    f'{max(t.rear_peak_torque for t in climbed):5.1f} N m')
+        else:
+            torque = energy = rear = f'refused: {group[0].code.name}'
+        failures = [t.code.name if t.code != ErrorCode.NONE else 'NONE but not on top'
+                    for t in group if not t.four]
+        typical = max(set(failures), key=failures.count) if failures else '-'
+        print(f'{height:.2f} m | {n} | {skipped:13d} | {sum(t.front for t in group) / n:6.0%}   '
+              f'| {sum(t.four for t in group) / n:6.0%}   | {torque:>24} | {energy:>19} | '
+              f'{rear:>32} | {car:8} | {typical}')
+    model_max, _ = kinematics.max_scalable_step(p, respect_tip_over=True)
+    front_best = table_of(trials, lambda t: t.front, description, '').limit
+    four_best = table_of(trials, lambda t: t.four, description, '').limit
+    car_best = max((h for h, ok in car_like.items() if ok), default=0.0)
+    print()
+    print(f'robot: centre of mass at {description.com_fraction:.0%} of the wheelbase, '
+          f'I_s {description.inertia_about_rear_axle:.2f} kg m^2 (thesis 0.84), differentials '
+          f'{description.front_differential}/{description.rear_differential}, drive '
+          f'{description.drive_torque_limit:.0f} N m, tyre friction {description.wheel_friction}')
+    print(f'model max scalable step (tip-over rule kept): {model_max:.3f} m = '
+          f'{model_max / p.r:.2f} r')
+    print(f'highest step climbed reliably (>= {RELIABLE:.0%} from the lowest up), front axle '
+          f'on top: {front_best:.2f} m = {front_best / model_max:.0%} of the model limit')
+    print(f'highest step climbed reliably, all four wheels on top: {four_best:.2f} m = '
+          f'{four_best / p.r:.2f} r')
+    if car_like:
+        print(f'car-like baseline, highest step climbed (four wheels): {car_best:.2f} m = '
+              f'{car_best / p.r:.2f} r')
+
+
+def _robot(args: argparse.Namespace) -> dict:
+    robot = {}
+    for path in args.design or []:
+        data = yaml.safe_load(Path(path).read_text())
+        robot.update(data['/**']['ros__parameters'])
+    for item in args.set or []:
+        name, _, value = item.partition('=')
+        robot[name] = yaml.safe_load(value)
+    return robot
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--min-height', type=float, default=0.02, help='[m]')
+    parser.add_argument('--max-height', type=float, default=0.20, help='[m]')
+    parser.add_argument('--step', type=float, default=0.01, help='[m]')
+    parser.add_argument('--trials', type=int, default=8, help='attempted climbs per height')
+    parser.add_argument('--max-draws', type=int, default=4,
+                        help='draw at most this many times --trials requests per height')
+    parser.add_argument('--seed', type=int, default=1)
+    parser.add_argument('--min-distance', type=float, default=0.2, help='[m]')
+    parser.add_argument('--max-distance', type=float, default=1.0, help='[m]')
+    parser.add_argument('--max-yaw', type=float, default=0.3, help='[rad]')
+    parser.add_argument('--min-width', type=float, default=0.8, help='[m]')
+    parser.add_argument('--max-width', type=float, default=2.0, help='[m]')
+    parser.add_argument('--max-offset', type=float, default=0.0,
+                        help='[m] the face centre along the edge, drawn within +-this')
+    parser.add_argument('--design', action='append', metavar='YAML',
+                        help='a robot description parameter file (config/designs/*.yaml)')
+    parser.add_argument('--set', action='append', metavar='NAME=VALUE',
+                        help='one robot description parameter, e.g. wheel_friction=0.8')
+    parser.add_argument('--skip-car-like', action='store_true')
+    parser.add_argument('--write-capability', type=Path, metavar='PATH',
+                        help='write the whole-car capability table the planner ships')
+    args = parser.parse_args(argv)
+    robot = _robot(args)
+    description = CarDescription().replace(**robot) if robot else CarDescription()
+    rng = random.Random(args.seed)
+    started = time.monotonic()
+    print(f'swivel car: {args.trials} attempted climbs per height, seed {args.seed}')
+    trials = run_swivel(args, robot, rng)
+    car_like = {} if args.skip_car_like else run_car_like(args, robot)
+    report(trials, car_like, description)
+    if args.write_capability:
+        command = 'python -m swivel_car_bringup.climb_benchmark ' + shlex.join(sys.argv[1:])
+        table = table_of(trials, lambda t: t.four, description, command)
+        table.save(args.write_capability, header=(
+            'Whole-car climbing capability of the robot description below, measured in physics\n'
+            'through the in-process stack; regenerate with the command below. The planner\n'
+            'refuses steps above the highest height climbed reliably.'))
+        print(f'wrote {args.write_capability}: whole-car limit {table.limit:.3f} m')
+    print(f'({time.monotonic() - started:.0f} s wall)')
+
+
+if __name__ == '__main__':
+    main()

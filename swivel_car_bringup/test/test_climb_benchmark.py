@@ -1,0 +1,33 @@
+"""The climbing benchmark's own arithmetic, and the shipped table of the climbing design."""
+
+from pathlib import Path
+
+from ament_index_python.packages import get_package_share_directory
+import numpy as np
+import yaml
+
+from swivel_car_model.description import CarDescription
+from swivel_car_planner.core.capability import CapabilityTable
+
+from swivel_car_bringup.climb_benchmark import heights, sign_changes
+
+
+def test_sign_changes_ignore_the_band_around_zero():
+    assert sign_changes(np.array([5.0, 0.5, -0.5, 4.0, -3.0, -2.0, 0.0, 6.0])) == 2
+    assert sign_changes(np.array([0.2, -0.3, 0.9])) == 0
+    assert sign_changes(np.array([])) == 0
+
+
+def test_heights_are_whole_increments_from_start_to_stop():
+    assert heights(0.02, 0.05, 0.01) == [0.02, 0.03, 0.04, 0.05]
+
+
+def test_the_climbing_design_ships_with_a_table_measured_on_it():
+    model = Path(get_package_share_directory('swivel_car_model'))
+    design = yaml.safe_load((model / 'config' / 'designs' / 'climbing.yaml').read_text())
+    description = CarDescription().replace(**design['/**']['ros__parameters'])
+    planner = Path(get_package_share_directory('swivel_car_planner'))
+    table = CapabilityTable.load(planner / 'config' / 'capability_climbing.yaml')
+    assert table.matches(description)
+    assert not table.matches(CarDescription())
+    assert table.limit >= 0.07
