@@ -208,11 +208,16 @@ def report(trials: list[Trial], car_like: dict[float, bool],
               f'{car_best / p.r:.2f} r')
 
 
+def design_values(path: str | Path) -> dict:
+    """The robot description parameters of a design file (``config/designs/*.yaml``, a
+    params file for every node: ``/**: ros__parameters``)."""
+    return dict(yaml.safe_load(Path(path).read_text())['/**']['ros__parameters'])
+
+
 def _robot(args: argparse.Namespace) -> dict:
     robot = {}
     for path in args.design or []:
-        data = yaml.safe_load(Path(path).read_text())
-        robot.update(data['/**']['ros__parameters'])
+        robot.update(design_values(path))
     for item in args.set or []:
         name, _, value = item.partition('=')
         robot[name] = yaml.safe_load(value)

@@ -4,12 +4,11 @@ from pathlib import Path
 
 from ament_index_python.packages import get_package_share_directory
 import numpy as np
-import yaml
 
 from swivel_car_model.description import CarDescription
 from swivel_car_planner.core.capability import CapabilityTable
 
-from swivel_car_bringup.climb_benchmark import heights, sign_changes
+from swivel_car_bringup.climb_benchmark import design_values, heights, sign_changes
 
 
 def test_sign_changes_ignore_the_band_around_zero():
@@ -24,8 +23,8 @@ def test_heights_are_whole_increments_from_start_to_stop():
 
 def test_the_climbing_design_ships_with_a_table_measured_on_it():
     model = Path(get_package_share_directory('swivel_car_model'))
-    design = yaml.safe_load((model / 'config' / 'designs' / 'climbing.yaml').read_text())
-    description = CarDescription().replace(**design['/**']['ros__parameters'])
+    description = CarDescription().replace(
+        **design_values(model / 'config' / 'designs' / 'climbing.yaml'))
     planner = Path(get_package_share_directory('swivel_car_planner'))
     table = CapabilityTable.load(planner / 'config' / 'capability_climbing.yaml')
     assert table.matches(description)

@@ -29,8 +29,8 @@ on the step the rear axle climbs by traction, which wants weight on the front wh
 wheels of each axle driven.
 
 Swivel gains. Thesis Table 2 (kp 19 N m/rad, ki 11.45 N m/(rad s), kd 5.5 N m s/rad, the
-documented starting point and ``SwivelCarParams``' defaults) is far too soft for the simulated car: the
-swivel must lift the body (about 5 N m of gravity load at 0.5 rad), so with kp = 19 the
+documented starting point and ``SwivelCarParams``' defaults) is far too soft for the simulated
+car: the swivel must lift the body (about 5 N m of gravity load at 0.5 rad), so with kp = 19 the
 proportional term alone cannot hold it and the integral has to do the work: a 0.5 rad step
 takes about 3 s to settle, and a 1.2 rad step overshoots by 18 % and does not settle within
 3 s (stick-slip limit cycle). Sweeping (kp, ki, kd) on the sim's step responses (0 -> 0.5,
@@ -64,7 +64,9 @@ FRONT_LINK = {'swivel': 'front_t', 'car_like': 'front_axle'}
 WHEEL_LINKS = ('rear_left_wheel', 'rear_right_wheel', 'front_left_wheel', 'front_right_wheel')
 
 
-def _field(default: Any, description: str) -> Any:
+def described(default: Any, description: str) -> Any:
+    """A dataclass field whose ``metadata['description']`` (with its unit) is also its ROS
+    parameter's description."""
     return field(default=default, metadata={'description': description})
 
 
@@ -80,32 +82,32 @@ class CarDescription:
         A field is of the wrong type, not finite or not physical; the message names it.
     """
 
-    l: float = _field(0.25, 'T column length, axle centre to apex [m]')
-    h: float = _field(0.15, 'half wheel shaft: wheel centre plane to the column [m]')
-    phi: float = _field(math.pi / 3, 'angle between the T columns (each rises at phi/2) [rad]')
-    r: float = _field(0.075, 'wheel radius [m]')
-    wheel_width: float = _field(0.03, 'wheel tread width [m]')
-    max_swivel_angle: float = _field(math.pi / 2,
+    l: float = described(0.25, 'T column length, axle centre to apex [m]')
+    h: float = described(0.15, 'half wheel shaft: wheel centre plane to the column [m]')
+    phi: float = described(math.pi / 3, 'angle between the T columns (each rises at phi/2) [rad]')
+    r: float = described(0.075, 'wheel radius [m]')
+    wheel_width: float = described(0.03, 'wheel tread width [m]')
+    max_swivel_angle: float = described(math.pi / 2,
                                      'mechanical swivel joint limit, symmetric [rad]')
-    wheel_mass: float = _field(0.5, 'mass of one wheel [kg]')
-    body_mass: float = _field(
+    wheel_mass: float = described(0.5, 'mass of one wheel [kg]')
+    body_mass: float = described(
         2.495619701085839, 'central body (batteries, motors, electronics) at the apex [kg]')
-    body_offset: float = _field(
+    body_offset: float = described(
         0.0, 'central body centre forward of the apex, along base_link x [m]')
-    rear_axle_mass: float = _field(12.704380298914161, 'rear axle housing with its '
+    rear_axle_mass: float = described(12.704380298914161, 'rear axle housing with its '
                                                        'differential [kg]')
-    front_axle_mass: float = _field(1.9, 'front axle housing with its differential [kg]')
-    column_mass: float = _field(0.95, 'mass of each T column [kg]')
-    front_differential: str = _field('open', "front axle differential: 'open' or 'locked'")
-    rear_differential: str = _field('open', "rear axle differential: 'open' or 'locked'")
-    drive_torque_limit: float = _field(
+    front_axle_mass: float = described(1.9, 'front axle housing with its differential [kg]')
+    column_mass: float = described(0.95, 'mass of each T column [kg]')
+    front_differential: str = described('open', "front axle differential: 'open' or 'locked'")
+    rear_differential: str = described('open', "rear axle differential: 'open' or 'locked'")
+    drive_torque_limit: float = described(
         10.0, 'largest total drive torque at the wheels (the drive motor) [N m]')
-    drive_speed_limit: float = _field(20.0, 'largest drive speed at the wheels [rad/s]')
-    swivel_torque_limit: float = _field(30.0, 'peak torque of the swivel actuator [N m]')
-    kp: float = _field(150.0, 'swivel PID proportional gain [N m/rad]')
-    ki: float = _field(200.0, 'swivel PID integral gain [N m/(rad s)]')
-    kd: float = _field(8.0, 'swivel PID derivative gain, on the measured rate [N m s/rad]')
-    wheel_friction: float = _field(1.0, 'friction coefficient of the tyres [1]')
+    drive_speed_limit: float = described(20.0, 'largest drive speed at the wheels [rad/s]')
+    swivel_torque_limit: float = described(30.0, 'peak torque of the swivel actuator [N m]')
+    kp: float = described(150.0, 'swivel PID proportional gain [N m/rad]')
+    ki: float = described(200.0, 'swivel PID integral gain [N m/(rad s)]')
+    kd: float = described(8.0, 'swivel PID derivative gain, on the measured rate [N m s/rad]')
+    wheel_friction: float = described(1.0, 'friction coefficient of the tyres [1]')
 
     def __post_init__(self) -> None:
         for item in fields(self):

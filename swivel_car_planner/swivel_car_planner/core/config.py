@@ -3,12 +3,9 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
-from typing import Any
+from dataclasses import dataclass, fields
 
-
-def _field(default: float, description: str) -> Any:
-    return field(default=default, metadata={'description': description})
+from swivel_car_model.description import described
 
 
 @dataclass(frozen=True)
@@ -23,69 +20,69 @@ class PlannerConfig:
         A field is not finite or out of its range; the message names the field.
     """
 
-    tip_over_margin: float = _field(
+    tip_over_margin: float = described(
         0.15, 'margin the plan keeps on the tip-over rule (pi - phi)/2 - theta1 [rad]')
-    clearance_margin: float = _field(
+    clearance_margin: float = described(
         0.01, 'lifted wheel lowest point above the step top [m]')
-    max_step_distance: float = _field(3.0, 'farthest step edge a request may name [m]')
-    max_step_yaw: float = _field(1.0, 'largest |step_yaw| the planner accepts [rad]')
-    max_backup: float = _field(
+    max_step_distance: float = described(3.0, 'farthest step edge a request may name [m]')
+    max_step_yaw: float = described(1.0, 'largest |step_yaw| the planner accepts [rad]')
+    max_backup: float = described(
         1.0, 'a step too close to turn onto the approach: the car first backs up straight, '
         'at most this far (what is behind it is not checked); 0: refuse instead [m]')
-    lead_margin: float = _field(
+    lead_margin: float = described(
         0.03, 'lifted wheel past the edge while the other front wheel is still clear [m]')
-    lift_gap: float = _field(0.03, 'lifted wheel front to the riser when the lift starts [m]')
-    max_lead_angle: float = _field(0.8, 'largest approach angle to the step normal [rad]')
-    approach_speed: float = _field(3.0, 'drive speed at the wheels while approaching [rad/s]')
-    climb_speed: float = _field(2.0, 'drive speed at the wheels while climbing [rad/s]')
-    rear_speed: float = _field(
+    lift_gap: float = described(0.03, 'lifted wheel front to the riser when the lift starts [m]')
+    max_lead_angle: float = described(0.8, 'largest approach angle to the step normal [rad]')
+    approach_speed: float = described(3.0, 'drive speed at the wheels while approaching [rad/s]')
+    climb_speed: float = described(2.0, 'drive speed at the wheels while climbing [rad/s]')
+    rear_speed: float = described(
         6.5, 'drive speed at the wheels while the rear axle climbs; its momentum helps the '
         'rear wheels up the riser [rad/s]')
-    swivel_rate: float = _field(0.6, 'swivel rate limit for lift and set-down [rad/s]')
-    max_steer: float = _field(0.35, 'largest steering angle used to align [rad]')
-    heading_gain: float = _field(1.5, 'steering angle per heading error [1]')
-    align_tolerance: float = _field(0.12, 'heading error allowed when the lift starts [rad]')
-    swivel_tolerance: float = _field(0.04, 'swivel counts as at its target within this [rad]')
-    settle_rate: float = _field(0.05, 'swivel counts as at rest below this rate [rad/s]')
-    settle_time: float = _field(0.3, 'swivel at its target and at rest this long [s]')
-    stop_speed: float = _field(
+    swivel_rate: float = described(0.6, 'swivel rate limit for lift and set-down [rad/s]')
+    max_steer: float = described(0.35, 'largest steering angle used to align [rad]')
+    heading_gain: float = described(1.5, 'steering angle per heading error [1]')
+    align_tolerance: float = described(0.12, 'heading error allowed when the lift starts [rad]')
+    swivel_tolerance: float = described(0.04, 'swivel counts as at its target within this [rad]')
+    settle_rate: float = described(0.05, 'swivel counts as at rest below this rate [rad/s]')
+    settle_time: float = described(0.3, 'swivel at its target and at rest this long [s]')
+    stop_speed: float = described(
         0.02, 'a climb asked while the car is faster than this first stops it, the swivel '
               'held [m/s]')
-    rear_slip_allowance: float = _field(
+    rear_slip_allowance: float = described(
         0.25, 'odometry past the edge beyond rest_margin with the car still pitched: the '
         'rear axle failed to climb [m]')
-    edge_margin: float = _field(
+    edge_margin: float = described(
         0.05, 'every wheel on top stays this far inside the sides of the step\'s top face '
         '(when the request gives its width) [m]')
-    crossing_gain: float = _field(
+    crossing_gain: float = described(
         4.0, 'approach: heading correction per metre of the centre line off its planned '
         'crossing of the edge [rad/m]')
-    rest_margin: float = _field(
+    rest_margin: float = described(
         0.05, 'rear wheel contacts past the edge to call the climb done [m]')
-    stop_allowance: float = _field(
+    stop_allowance: float = described(
         0.3, 'travel on the top face after the rear wheels are rest_margin past the edge: '
         'they leave the riser at speed, the car comes level, then stops [m]')
-    level_tolerance: float = _field(
+    level_tolerance: float = described(
         0.12, 'largest |pitch| that counts as level while the rear axle climbs [rad]')
-    rest_tolerance: float = _field(
+    rest_tolerance: float = described(
         0.05, 'largest |pitch| (and twice that |roll|) of the car standing on top to call '
         'the climb done [rad]')
-    bias_gain: float = _field(
+    bias_gain: float = described(
         2.0, 'outer loop: command bias per remaining swivel error and second [1/s]')
-    max_bias: float = _field(0.6, 'outer loop: largest command bias [rad]')
-    max_swivel_command: float = _field(1.2, 'largest |swivel command| sent [rad]')
-    stall_progress: float = _field(
+    max_bias: float = described(0.6, 'outer loop: largest command bias [rad]')
+    max_swivel_command: float = described(1.2, 'largest |swivel command| sent [rad]')
+    stall_progress: float = described(
         0.01, 'the swivel must close on its goal by this much every stall_time [rad]')
-    stall_time: float = _field(4.0, 'swivel making no headway this long: stall [s]')
-    slip_yaw_tolerance: float = _field(
+    stall_time: float = described(4.0, 'swivel making no headway this long: stall [s]')
+    slip_yaw_tolerance: float = described(
         0.6, 'IMU and odometry headings parting this far while the rear axle climbs: the '
         'wheels slip (locked differentials scrub: on climbs that ended on top in the sim '
         'they parted by more than 0.25 rad) [rad]')
-    no_progress_time: float = _field(4.0, 'window of the no-progress monitor [s]')
-    min_progress: float = _field(0.01, 'path length the car must make in that window [m]')
-    pitch_abort_margin: float = _field(
+    no_progress_time: float = described(4.0, 'window of the no-progress monitor [s]')
+    min_progress: float = described(0.01, 'path length the car must make in that window [m]')
+    pitch_abort_margin: float = described(
         0.08, 'abort when the nose-up pitch comes this near the tip-over rule [rad]')
-    time_allowance: float = _field(60.0, 'default climb time limit, sim time [s]')
+    time_allowance: float = described(60.0, 'default climb time limit, sim time [s]')
 
     def __post_init__(self) -> None:
         for item in fields(self):

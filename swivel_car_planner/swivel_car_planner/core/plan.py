@@ -33,9 +33,9 @@ rising wheel into the riser.
 
 from __future__ import annotations
 
-import math
 import dataclasses
 from dataclasses import dataclass
+import math
 
 from swivel_car_model import climbing, dynamics, kinematics
 from swivel_car_model.params import SwivelCarParams
@@ -114,11 +114,11 @@ def crossing_range(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequ
     """Where along the edge the car's centre line may cross it so that every wheel that is on
     the step stays on its top face, ``edge_margin`` inside its sides, while the car drives on
     at ``heading`` (to the normal) until the trailing rear wheel is ``rest_margin`` past the
-    edge and then ``stop_allowance`` further until it stands. Along the edge leftwards from where the request's x axis meets it; empty (low >
-    high) when the face is too narrow. # [m]"""
+    edge, and ``stop_allowance`` further until it stands. Along the edge leftwards from where
+    the request's x axis meets it; empty (low > high) when the face is too narrow. # [m]"""
     sine, cosine = math.sin(heading), math.cos(heading)
     # Along the heading from the crossing, the wheels on top lie between the rear axle at
-    # the crossing and the front axle once the trailing rear wheel is rest_margin past.
+    # the crossing and the front axle once the car stands.
     reach = ((config.rest_margin + p.h * abs(sine)) / cosine + config.stop_allowance
              + p.wheelbase)  # [m]
     half = p.h * cosine + p.wheel_width / 2.0 + config.edge_margin

@@ -393,6 +393,7 @@ class ClimbStateMachine:
         self._stall_ref = (obs.time, math.inf)
         plan, config = self._plan, self._config
         spans = {
+            Step.STOP: (abs(obs.speed), 0.0),
             Step.BACK_UP: (self._backed_up(obs), plan.backup_distance),
             Step.APPROACH: (self._lifted_wheel_distance(obs), -plan.lead_distance),
             Step.LIFT: (obs.swivel, plan.swivel_angle),
@@ -447,19 +448,15 @@ class ClimbStateMachine:
     # --- monitors and bookkeeping ---------------------------------------------------------
 
     def _start(self, obs: Observation) -> None:
-        self._edge = StepEdge.from_request(Pose2D(obs.x, obs.y, obs.yaw), self._p.wheelbase,
+        self._origin = Pose2D(obs.x, obs.y, obs.yaw)
+        self._edge = StepEdge.from_request(self._origin, self._p.wheelbase,
                                            self._step_distance, self._step_yaw)
         self._start_time = obs.time
-        self._origin = Pose2D(obs.x, obs.y, obs.yaw)
         self._yaw_offset = obs.imu_yaw - obs.yaw
-        self._progress_ref = (obs.time, 0.0)
-        self._stall_ref = (obs.time, math.inf)
-        if abs(obs.speed) > self._config.stop_speed:
-            self._step = Step.STOP
+        moving = abs(obs.speed) > self._config.stop_speed
+        if moving:
             self._last_command = obs.swivel
-            self._span = (abs(obs.speed), 0.0)
-        else:
-            self._switch(self._first_move(), obs)
+        self._switch(Step.STOP if moving else self._first_move(), obs)
 
     def _measure(self, obs: Observation) -> None:
         if self._last is not None:
