@@ -32,7 +32,7 @@ import time
 import numpy as np
 import yaml
 
-from swivel_car_model import kinematics
+from swivel_car_model import kinematics, traction
 from swivel_car_model.description import CarDescription
 from swivel_car_planner.core import ClimbRequest, ErrorCode
 from swivel_car_planner.core.capability import CapabilityTable, description_values, RELIABLE
@@ -45,6 +45,7 @@ _REFUSED = (ErrorCode.UNREACHABLE_HEIGHT, ErrorCode.TIP_OVER, ErrorCode.TORQUE_L
 _CHATTER_TORQUE = 1.0  # [N m] torque sign changes count between values beyond +-this
 _CAR_LIKE_SPEED = 0.5  # [m/s] the baseline's drive speed at the step
 _CAR_LIKE_TIME = 6.0  # [s] sim time it drives
+_TARGET_HEIGHT = 0.08  # [m] the whole-car climb the product aims at (issue 11)
 
 
 @dataclass(frozen=True)
@@ -80,8 +81,9 @@ def sign_changes(torque: np.ndarray, threshold: float = _CHATTER_TORQUE) -> int:
 
 def run_swivel(args: argparse.Namespace, robot: dict, rng: random.Random) -> list[Trial]:
     trials = []
-    with InProcessStack(robot=robot, planner={'capability_file': 'none'}) as stack:
-        for height in heights(args.min_height, args.max_height, args.step):
+    planner = {'capability_file': 'none', **_assignments(args.planner)}
+    with InProcessStack(robot=robot, planner=planner) as stack:
+        for height in _heights(args):
             attempted = drawn = 0
             while attempted < args.trials and drawn < args.trials * args.max_draws:
                 drawn += 1
@@ -124,7 +126,7 @@ def run_car_like(args: argparse.Namespace, robot: dict) -> dict[float, bool]:
     top. Stops after two heights in a row fail (higher ones only fail the more)."""
     results: dict[float, bool] = {}
     with InProcessStack('car_like', robot=robot) as stack:
-        for height in heights(args.min_height, args.max_height, args.step):
+        for height in _heights(args):
             stack.reset()
             stack.settle(0.2)
             stack.spawn_step(height, 0.3, depth=10.0)  # deep: it must not drive off the far side
@@ -206,6 +208,13 @@ def report(trials: list[Trial], car_like: dict[float, bool],
     if car_like:
         print(f'car-like baseline, highest step climbed (four wheels): {car_best:.2f} m = '
               f'{car_best / p.r:.2f} r')
+    com_height, mu = float(description.com[2]), description.wheel_friction
+    quasi_static = traction.trailing_axle_limit(p, description.com_fraction, com_height, mu)
+    needed = max(traction.trailing_axle_min_com(p, h, com_height, mu)
+                 for h in heights(0.01, _TARGET_HEIGHT, 0.005))
+    print(f'rear axle by traction, quasi-static model (swivel_car_model.traction): up to '
+          f'{quasi_static:.3f} m with this layout; every step to {_TARGET_HEIGHT:.2f} m needs '
+          f'the centre of mass at >= {needed:.0%} of the wheelbase')
 
 
 def design_values(path: str | Path) -> dict:
@@ -214,14 +223,25 @@ def design_values(path: str | Path) -> dict:
     return dict(yaml.safe_load(Path(path).read_text())['/**']['ros__parameters'])
 
 
+def _assignments(items: list[str] | None) -> dict:
+    """``NAME=VALUE`` arguments as a dict, each value read as YAML."""
+    values = {}
+    for item in items or []:
+        name, _, value = item.partition('=')
+        values[name] = yaml.safe_load(value)
+    return values
+
+
 def _robot(args: argparse.Namespace) -> dict:
     robot = {}
     for path in args.design or []:
         robot.update(design_values(path))
-    for item in args.set or []:
-        name, _, value = item.partition('=')
-        robot[name] = yaml.safe_load(value)
+    robot.update(_assignments(args.set))
     return robot
+
+
+def _heights(args: argparse.Namespace) -> list[float]:
+    return args.heights or heights(args.min_height, args.max_height, args.step)
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -229,6 +249,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument('--min-height', type=float, default=0.02, help='[m]')
     parser.add_argument('--max-height', type=float, default=0.20, help='[m]')
     parser.add_argument('--step', type=float, default=0.01, help='[m]')
+    parser.add_argument('--heights', type=lambda text: [float(v) for v in text.split(',')],
+                        metavar='H1,H2,...', help='[m] these heights instead of the range')
     parser.add_argument('--trials', type=int, default=8, help='attempted climbs per height')
     parser.add_argument('--max-draws', type=int, default=4,
                         help='draw at most this many times --trials requests per height')
@@ -244,6 +266,8 @@ def main(argv: list[str] | None = None) -> None:
                         help='a robot description parameter file (config/designs/*.yaml)')
     parser.add_argument('--set', action='append', metavar='NAME=VALUE',
                         help='one robot description parameter, e.g. wheel_friction=0.8')
+    parser.add_argument('--planner', action='append', metavar='NAME=VALUE',
+                        help='one planner parameter, e.g. rear_speed=8.0')
     parser.add_argument('--skip-car-like', action='store_true')
     parser.add_argument('--write-capability', type=Path, metavar='PATH',
                         help='write the whole-car capability table the planner ships')

@@ -525,7 +525,7 @@ class InProcessStack:
         try:
             self.controller.core.set_swivel_command(
                 float(command.angle), float(command.max_rate), float(command.drive_speed),
-                bool(command.hold), stamp)
+                bool(command.hold), stamp, bool(command.free))
         except ValueError as error:  # the node logs it and keeps the previous command
             self.refused_commands.append(f'{stamp:.2f} s: {error}')
 

@@ -153,7 +153,7 @@ class ControllerNode(Node):
             # The deadman counts from receipt: a planner that lags behind a lockstep sim
             # running ahead of it (before its first command held the sim back) is not dead.
             self._core.set_swivel_command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold,
-                                          self._now())
+                                          self._now(), msg.free)
         except ValueError as error:
             self.get_logger().error(str(error), throttle_duration_sec=1.0)
         else:

@@ -121,6 +121,25 @@ def test_swivel_command_takes_over_and_releases():
     assert out.target == 0.0
 
 
+def test_free_swivel_command_gives_no_torque_and_holds_at_the_tip_safe_limit():
+    controller = make(cmd_vel_timeout=0.0, swivel_command_timeout=0.0)
+    run(controller, 0.0, 0.2, measured=0.0)
+    controller.set_swivel_command(0.0, 0.0, 3.0, True, 0.2, free=True)
+    for k, angle in enumerate((0.1, 0.3, -0.4, 0.2)):  # the load turns the swivel
+        out = controller.step(0.2 + (k + 1) * DT, angle, 5.0)
+        assert out.swivel_torque == 0.0
+        assert out.target == angle and out.set_point == angle
+        assert out.source == SOURCE_SWIVEL_COMMAND
+    assert out.drive_speed > 0.0
+    beyond = controller.swivel_limit + 0.05
+    out = controller.step(0.3, beyond, 0.0)
+    assert out.target == controller.swivel_limit and out.swivel_torque < 0.0
+    # Held again from where it is: no jump of the set point.
+    controller.set_swivel_command(0.5, 0.0, 0.0, True, 0.3)
+    out = controller.step(0.31, 0.2, 0.0)
+    assert out.set_point == pytest.approx(controller.swivel_limit, abs=0.02)
+
+
 def test_stale_swivel_command_is_released_holding_the_swivel():
     """The planner died: its last command (driving, swivel at 0.6) expires, the drive stops,
     the swivel holds where the command left it, and cmd_vel steers again."""

@@ -289,6 +289,7 @@ class PlannerNode(Node):
         msg.max_rate = float(command.max_rate)
         msg.drive_speed = float(command.drive_speed)
         msg.hold = bool(command.hold)
+        msg.free = bool(command.free)
         self._command_pub.publish(msg)
 
     @staticmethod

@@ -145,6 +145,15 @@ def test_step_too_close_to_align_is_invalid_without_room_to_back_up():
     assert 'too close' in error.message and 'max_backup' in error.message
 
 
+def test_a_refusal_after_backing_up_says_what_still_stands_in_the_way():
+    # Straight at a face centred on the car: backing up makes room to turn, but the single
+    # turn onto the lead angle then crosses the edge beside the face.
+    error = refusal(height=0.05, distance=0.6, width=1.6)
+    assert error.code == ErrorCode.INVALID_REQUEST
+    first, _, then = error.message.partition('max_backup')
+    assert 'aligning to' in first and 'beside the top face' in then
+
+
 @pytest.mark.parametrize('yaw, width', [(0.0, 0.0), (0.3, 0.0), (-0.3, 2.0)])
 def test_a_close_step_is_planned_from_the_least_backup_that_makes_room(yaw, width):
     near = make_plan(P, CONFIG, request(0.05, distance=0.2, yaw=yaw, width=width))

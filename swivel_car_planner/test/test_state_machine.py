@@ -129,6 +129,18 @@ def test_rear_axle_that_does_not_climb_ends_failed_and_stopped():
     assert 'rear axle' in machine.outcome.message
 
 
+def test_the_rear_axle_climbs_with_the_swivel_free_and_stops_held():
+    machine, _ = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.step == Step.REAR)
+    run(machine, car, until=lambda m, c: m.step != Step.REAR)
+    rear = [c for c in car.commands if c.free]
+    assert rear and all(c.hold and c.drive_speed == CONFIG.rear_speed for c in rear)
+    assert not any(c.free for c in car.commands[:car.commands.index(rear[0])])
+    run(machine, car)
+    assert machine.outcome.success and not car.commands[-1].free
+
+
 def test_front_coming_down_before_the_rear_reaches_the_edge_ends_failed():
     machine, _ = start()
     car = KinematicCar()
@@ -156,7 +168,7 @@ def assert_safe_abort(machine, car, code):
     assert machine.outcome.error_code == code, machine.outcome.message
     assert machine.feedback.phase == Phase.ABORTING
     final = car.commands[-1]
-    assert final.drive_speed == 0.0 and final.hold
+    assert final.drive_speed == 0.0 and final.hold and not final.free
     assert final.angle == pytest.approx(car.swivel)
     # Further updates keep the car stopped and the swivel held.
     assert machine.update(car.observe()) == final

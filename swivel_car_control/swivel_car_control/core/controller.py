@@ -98,6 +98,7 @@ class SwivelCommandRequest:
     max_rate: float  # [rad/s], 0 = controller default
     drive_speed: float  # [rad/s] at the wheels
     stamp: float  # [s] when it was received, for the deadman
+    free: bool = False  # no swivel torque within the tip-safe limit
 
 
 @dataclass(frozen=True)
@@ -172,9 +173,11 @@ class SwivelController:
         self._cmd_vel = (float(v), float(omega), float(stamp))
 
     def set_swivel_command(self, angle: float, max_rate: float, drive_speed: float,
-                           hold: bool, stamp: float) -> None:
+                           hold: bool, stamp: float, free: bool = False) -> None:
         """Take the planner's direct command, received at ``stamp`` [s] (the deadman's
-        reference); ``hold=False`` releases it to cmd_vel.
+        reference); ``hold=False`` releases it to cmd_vel. ``free`` lets the swivel turn
+        with no torque (``angle`` unused) while it stays within the tip-safe limit, where it
+        is held.
 
         Raises
         ------
@@ -203,7 +206,8 @@ class SwivelController:
                 f'swivel_command angle {angle!r} rad breaks the tip-over rule (thesis eq. 72) '
                 f'with margin {self.config.tip_over_margin!r} rad: refused')
         self._swivel_command = SwivelCommandRequest(float(angle), float(max_rate),
-                                                    float(drive_speed), float(stamp))
+                                                    float(drive_speed), float(stamp),
+                                                    bool(free))
 
     def step(self, t: float, measured: float, measured_rate: float) -> ControlOutput:
         """One control period at time ``t`` [s] with the measured swivel angle [rad] and rate
@@ -224,9 +228,16 @@ class SwivelController:
             < t - command.stamp
         if command_timed_out:
             self._swivel_command = command = None
+        free = command is not None and command.free and abs(measured) < self.swivel_limit
+        if command is not None and command.free:
+            # Bumpless: the set point rides on the measured angle (clamped to the tip-safe
+            # limit, where it is held), so holding again starts from where the swivel is.
+            self._set_point.reset(max(-self.swivel_limit, min(self.swivel_limit, measured)))
+            if free:
+                self.pid.reset()
         if command is not None:
             source = SOURCE_SWIVEL_COMMAND
-            self._target = command.angle
+            self._target = self._set_point.value if command.free else command.angle
             if command.max_rate > 0.0:
                 max_rate = command.max_rate
             drive_target = command.drive_speed
@@ -254,7 +265,8 @@ class SwivelController:
                          if resolved.tightest else resolved.v)
                 drive_target = planar.wheel_rate_for_speed(self.p, speed)
         set_point = self._set_point.step(self._target, dt, max_rate)
-        pid = self.pid.step(set_point, measured, measured_rate, dt)
+        pid = (PidOutput(0.0, 0.0, 0.0, 0.0, False) if free
+               else self.pid.step(set_point, measured, measured_rate, dt))
         scale = steering_speed_scale(self._target - measured, self.config.slowdown_start,
                                      self.config.slowdown_stop)
         drive = self._drive.step(drive_target * scale, dt)

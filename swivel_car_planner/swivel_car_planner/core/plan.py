@@ -276,7 +276,7 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
         raise PlanError(ErrorCode.INVALID_REQUEST,
                         first_error if config.max_backup == 0.0 else
                         f'{first_error}; backing up {config.max_backup:.2f} m (max_backup) '
-                        f'does not make room either')
+                        f'does not make room either: then {approach.error}')
     available = request.step_distance * math.cos(request.step_yaw)
     side, psi_lead, approach_heading = approach.side, approach.lead, approach.heading
     lead_distance, axle_normal = approach.lead_distance, approach.axle_normal

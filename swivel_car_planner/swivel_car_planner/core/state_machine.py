@@ -18,9 +18,10 @@ action phase each one reports)::
                      the other front wheel is ``clearance_margin`` above it     SET_DOWN
     SECOND_ADVANCE   drive until the second front wheel is over the step        CLIMB_REST
     SECOND_SET_DOWN  stop; swivel to 0: the second wheel lands                  CLIMB_REST
-    REAR             drive, holding the lead heading, until the rear wheels are
-                     past the edge and the car is level; the rear axle has no
-                     lift, it climbs by traction only                           CLIMB_REST
+    REAR             drive at ``rear_speed``, the swivel free (no torque), until
+                     the rear wheels are past the edge and the car is level;
+                     the rear axle has no lift, it climbs by traction and
+                     momentum only                                              CLIMB_REST
     STOP_ON_TOP      drive 0, the swivel held where it is, until odometry says
                      the car stands; done if it is still level                  CLIMB_REST
 
@@ -116,6 +117,7 @@ class Command:
     max_rate: float  # [rad/s], 0 = controller default
     drive_speed: float  # [rad/s] at the wheels
     hold: bool
+    free: bool = False  # no swivel torque: the load turns the swivel (angle unused)
 
 
 @dataclass(frozen=True)
@@ -315,7 +317,13 @@ class ClimbStateMachine:
                 f'the front wheels are on top but the rear axle did not climb: odometry '
                 f'puts it {rear:.2f} m past the edge while the pitch is still {obs.pitch:.3f} '
                 f'rad (the rear wheels slip; they climb by traction only)')
-        return self._steer(obs, plan.lead_angle, config.rear_speed)
+        # Free, the swivel lets the rear T roll under the front one, so each rear wheel
+        # meets the riser with its own load; held, it twisted a rear wheel off its traction
+        # (docs/climbing_design.md).
+        self._bias = 0.0
+        self._goal_error = None
+        self._last_command = obs.swivel
+        return Command(obs.swivel, config.swivel_rate, config.rear_speed, True, free=True)
 
     def _first_move(self) -> Step:
         return Step.BACK_UP if self._plan.backup_distance > 0.0 else Step.APPROACH
