@@ -31,6 +31,7 @@ from sensor_msgs.msg import JointState
 from swivel_car_msgs.action import ClimbStep
 from swivel_car_msgs.msg import StepObstacle, SwivelControllerState
 from swivel_car_msgs.srv import SpawnObstacle
+from swivel_car_planner.core import capability
 
 from demo_report import write_report
 from swivel_car_sim.physics import StepSpec
@@ -262,8 +263,9 @@ def summarise(args, recording: Recording, result, climb_start: float, climb_end:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--step-height', type=float, default=0.04,
-                        help='[m] (the default robot\'s whole-car limit, capability.yaml)')
+    parser.add_argument('--step-height', type=float, default=None,
+                        help='[m] default: the highest step the whole car climbs reliably, '
+                        'the planner\'s installed capability table')
     parser.add_argument('--step-distance', type=float, default=1.8,
                         help='[m] front axle ground contact to the step edge at the start')
     parser.add_argument('--stop-before', type=float, default=1.0,
@@ -274,6 +276,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--domain-id', type=int, default=60 + os.getpid() % 40)
     parser.add_argument('--report', type=Path, default=REPO_ROOT / 'report')
     args = parser.parse_args(argv)
+    if args.step_height is None:
+        table, _ = capability.table_for(capability.INSTALLED)
+        args.step_height = table.limit
 
     progress = Progress()
     try:
