@@ -7,6 +7,7 @@ from typing import Any, Mapping, TypeVar
 
 import rclpy
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from swivel_car_model import description
@@ -81,7 +82,7 @@ def run_node(node_class: type[Node], name: str, args: list[str] | None = None) -
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    except ValueError as error:
+    except (ValueError, ParameterException) as error:
         rclpy.logging.get_logger(name).fatal(f'bad configuration: {error}')
         return 1
     finally:
