@@ -6,7 +6,7 @@ import subprocess
 
 import pytest
 
-from swivel_car_stack import REPO_ROOT
+from swivel_car_testing import REPO_ROOT, next_domain_id
 
 INSTALL = REPO_ROOT / 'ros2_ws' / 'install'
 CASES = [
@@ -20,7 +20,7 @@ CASES = [
 @pytest.mark.parametrize('package, executable, name, value', CASES)
 def test_a_wrong_type_at_start_is_one_fatal_line_and_exit_1(package, executable, name, value):
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
-               ROS_DOMAIN_ID=str(200 + CASES.index((package, executable, name, value))))
+               ROS_DOMAIN_ID=str(next_domain_id()))
     done = subprocess.run(
         [str(REPO_ROOT / 'scripts' / 'in_ws'), str(INSTALL / package / 'lib' / package / executable),
          '--ros-args', '-p', f'{name}:={value}'],
