@@ -259,11 +259,6 @@ def stack():
         spin_until(route_driver.executor, lambda: route_driver.time > 0.0 and route_driver.odom,
                    60.0, 'the stack')
         yield route_driver, processes['controller_node']
-        # The stack idle before SIGINT: an rclpy node interrupted while taking a message
-        # may end with a traceback and exit code 1.
-        route_driver.flow_control = False
-        future = route_driver.pause.call_async(SetBool.Request(data=True))
-        spin_until(route_driver.executor, future.done, 30.0, 'the sim to pause')
     finally:
         route_driver.close()
         codes = {process.name: process.stop() for process in processes.values()}
