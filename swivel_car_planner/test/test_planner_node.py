@@ -59,8 +59,7 @@ class Rig:
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.car = KinematicCar()
-        self.commands: list[Command] = []  # received, not yet applied by drive()
-        self.answering = False  # a climb answers every cycle (drive)
+        self.command = None
         self.received: list[SwivelCommand] = []
         self.node.create_subscription(SwivelCommand, 'swivel_command', self._on_command, 10)
         self.clock = self.node.create_publisher(Clock, '/clock', 10)
@@ -76,7 +75,7 @@ class Rig:
 
     def _on_command(self, msg):
         self.received.append(msg)
-        self.commands.append(Command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold))
+        self.command = Command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold)
 
     def publish_state(self, inputs=('joint_states', 'imu', 'odom', 'controller')):
         """One control cycle of the robot: clock, then the requested inputs."""
@@ -115,26 +114,19 @@ class Rig:
     def drive(self, future, seconds=120.0):
         """Close the loop until ``future`` is done: the car follows the planner's commands.
 
-        Lockstep by hand: each cycle waits for the planner's command of that cycle. Until a
-        climb is registered there is none (a brief wait, then the car keeps the last one);
-        from the climb's first command to its release every cycle waits for its command, so
-        that no command lands a cycle late however busy the machine is.
+        Lockstep by hand: each cycle waits (briefly) for the planner's command of that cycle;
+        until a climb is registered there is none, and the car keeps the last one.
         """
         last = Command(0.0, 0.0, 0.0, False)
         while not future.done() and self.car.time < seconds:
             self.publish_state()
-            if self.answering:
-                spin_until(self.executor, lambda: self.commands or future.done(),
-                           30.0, "the planner's command of this cycle")
             deadline = time.monotonic() + 0.5
-            while not self.commands and not future.done() and time.monotonic() < deadline:
+            while self.command is None and not future.done() and time.monotonic() < deadline:
                 self.executor.spin_once(timeout_sec=0.005)
-            # In order (the end of a climb sends a hold and its release at once); a release
-            # leaves the swivel where it was and stops, as the controller does.
-            for command in self.commands:
-                self.answering = command.hold
-                last = command if command.hold else Command(last.angle, 0.0, 0.0, False)
-            self.commands.clear()
+            if self.command is not None:
+                # A release leaves the swivel where it was and stops, as the controller does.
+                last = self.command if self.command.hold else Command(last.angle, 0.0, 0.0, False)
+                self.command = None
             self.car.apply(last)
         spin_until(self.executor, future.done, 10.0, 'the result')
         return future.result()
@@ -180,7 +172,7 @@ def test_malformed_request_is_invalid_and_nothing_moves(rig):
     assert not response.success
     assert response.error_code == ClimbStepService.Response.ERROR_INVALID_REQUEST
     assert 'step_height' in response.message
-    assert not rig.commands
+    assert rig.command is None
 
 
 def test_request_before_the_robot_is_up_is_not_ready(rig):
@@ -190,7 +182,7 @@ def test_request_before_the_robot_is_up_is_not_ready(rig):
     response = result_of(rig, rig.call(**SUCCESSFUL_CLIMB))
     assert response.error_code == ClimbStepService.Response.ERROR_NOT_READY
     assert 'odom' in response.message
-    assert not rig.commands
+    assert rig.command is None
 
 
 def test_plan_only_returns_the_plan_without_moving(rig):
@@ -199,14 +191,14 @@ def test_plan_only_returns_the_plan_without_moving(rig):
     assert response.plan.swivel_angle > 0.0
     assert response.plan.tip_over_margin > 0.0
     assert response.plan.duration > 0.0
-    assert not rig.commands
+    assert rig.command is None
 
 
 def test_unreachable_step_is_refused_without_motion(rig):
     rig.warm_up()
     response = result_of(rig, rig.call(step_height=0.5, step_distance=1.0))
     assert response.error_code == ClimbStepService.Response.ERROR_UNREACHABLE_HEIGHT
-    assert not rig.commands
+    assert rig.command is None
 
 
 def test_service_climbs_and_a_second_request_meanwhile_is_busy(rig):
