@@ -22,9 +22,6 @@ from swivel_car_control.ros_params import (
     declare_dataclass, declare_description, refuse_runtime_changes, run_node)
 
 
-JOINT_STATES_QUEUE = 100  # [messages] 1 s of the sim's 100 Hz joint_states
-
-
 @dataclass(frozen=True)
 class OdometryConfig:
     """Frames, rates and covariances of the odometry node (see CONFIG_DESCRIPTIONS)."""
@@ -110,11 +107,7 @@ class OdometryNode(Node):
         self._pose_covariance = _diagonal(config.pose_covariance_diagonal)
         self._twist_covariance = _diagonal(config.twist_covariance_diagonal)
         self._odom_pub = self.create_publisher(Odometry, 'odom', 10)
-        # Every state must be integrated: a deep queue, so that an odometry starved for a
-        # moment by a busy machine catches up instead of losing joint_states (with 10 it lost
-        # some whenever a lockstep sim ran 10 states ahead of it, a few mm on a swivel sweep).
-        self.create_subscription(JointState, 'joint_states', self._on_joint_states,
-                                 JOINT_STATES_QUEUE)
+        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
         self.create_service(Empty, '~/reset', self._on_reset)
         self.create_service(SetPose2D, '~/set_pose', self._on_set_pose)
 
