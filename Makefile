@@ -6,10 +6,6 @@ VENV := .venv
 STAMP := $(VENV)/.requirements-installed
 IN_WS := scripts/in_ws
 PYTEST_ARGS ?=
-# Independent test files run side by side (pytest-xdist, one worker per core, a file's tests
-# on one worker); each worker starts its nodes on ROS domains of its own
-# (tests/support/swivel_car_testing.py). PYTEST_PARALLEL= runs them one after the other.
-PYTEST_PARALLEL ?= -n auto --maxprocesses=4 --dist loadfile
 
 .PHONY: setup build test demo figures bench clean
 
@@ -28,7 +24,7 @@ build: setup
 
 test: build
 	@echo '== running every test'
-	$(IN_WS) python -m pytest $(PYTEST_PARALLEL) $(PYTEST_ARGS)
+	$(IN_WS) python -m pytest $(PYTEST_ARGS)
 
 demo: build
 	@echo '== running the demo: the simulated car drives to a step and climbs it'
