@@ -230,9 +230,9 @@ class SwivelController:
             self._swivel_command = command = None
         free = command is not None and command.free and abs(measured) < self.swivel_limit
         if command is not None and command.free:
-            # Bumpless: the set point rides on the measured angle (clamped to the tip-safe
-            # limit, where it is held), so holding again starts from where the swivel is.
-            self._set_point.reset(max(-self.swivel_limit, min(self.swivel_limit, measured)))
+            # Bumpless: the set point rides on the measured angle (the limiter clamps it to
+            # the tip-safe limit, where it is held), so holding again starts from there.
+            self._set_point.reset(measured)
             if free:
                 self.pid.reset()
         if command is not None:

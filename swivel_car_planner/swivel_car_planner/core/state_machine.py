@@ -320,10 +320,7 @@ class ClimbStateMachine:
         # Free, the swivel lets the rear T roll under the front one, so each rear wheel
         # meets the riser with its own load; held, it twisted a rear wheel off its traction
         # (docs/climbing_design.md).
-        self._bias = 0.0
-        self._goal_error = None
-        self._last_command = obs.swivel
-        return Command(obs.swivel, config.swivel_rate, config.rear_speed, True, free=True)
+        return self._open_loop(obs.swivel, config.rear_speed, free=True)
 
     def _first_move(self) -> Step:
         return Step.BACK_UP if self._plan.backup_distance > 0.0 else Step.APPROACH
@@ -355,10 +352,15 @@ class ClimbStateMachine:
         error = heading - self._edge.relative_heading(self._heading(obs))
         limit = self._config.max_steer
         steering = min(limit, max(-limit, self._config.heading_gain * error))
+        return self._open_loop(float(kinematics.swivel_for_steering(self._p, steering)),
+                               drive_speed)
+
+    def _open_loop(self, angle: float, drive_speed: float, free: bool = False) -> Command:
+        """Command ``angle`` as it is, no outer loop (its bias starts again from zero)."""
         self._bias = 0.0
         self._goal_error = None
-        self._last_command = float(kinematics.swivel_for_steering(self._p, steering))
-        return Command(self._last_command, self._config.swivel_rate, drive_speed, True)
+        self._last_command = angle
+        return Command(angle, self._config.swivel_rate, drive_speed, True, free)
 
     def _hold(self, obs: Observation, angle: float, drive_speed: float) -> Command:
         """Bring the measured swivel to ``angle`` (outer loop, see the module docstring)
