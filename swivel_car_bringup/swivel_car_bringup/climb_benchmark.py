@@ -82,7 +82,8 @@ def sign_changes(torque: np.ndarray, threshold: float = _CHATTER_TORQUE) -> int:
 def run_swivel(args: argparse.Namespace, robot: dict, rng: random.Random) -> list[Trial]:
     trials = []
     planner = {'capability_file': 'none', **_assignments(args.planner)}
-    with InProcessStack(robot=robot, planner=planner) as stack:
+    with InProcessStack(robot=robot, planner=planner,
+                        controller=_assignments(args.controller)) as stack:
         for height in _heights(args):
             attempted = drawn = 0
             while attempted < args.trials and drawn < args.trials * args.max_draws:
@@ -268,6 +269,8 @@ def main(argv: list[str] | None = None) -> None:
                         help='one robot description parameter, e.g. wheel_friction=0.8')
     parser.add_argument('--planner', action='append', metavar='NAME=VALUE',
                         help='one planner parameter, e.g. rear_speed=8.0')
+    parser.add_argument('--controller', action='append', metavar='NAME=VALUE',
+                        help='one controller parameter, e.g. max_linear_velocity=1.0')
     parser.add_argument('--skip-car-like', action='store_true')
     parser.add_argument('--write-capability', type=Path, metavar='PATH',
                         help='write the whole-car capability table the planner ships')

@@ -29,4 +29,4 @@ def test_the_climbing_design_ships_with_a_table_measured_on_it():
     table = CapabilityTable.load(planner / 'config' / 'capability_climbing.yaml')
     assert table.matches(description)
     assert not table.matches(CarDescription())
-    assert table.limit >= 0.06
+    assert table.limit >= 0.07

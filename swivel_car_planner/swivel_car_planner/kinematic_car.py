@@ -33,6 +33,7 @@ class KinematicCar:
         self.stuck = False
         self.blocked = False
         self.extra_pitch = 0.0  # [rad] added nose-down pitch
+        self.roll = 0.0  # [rad] as the IMU reports it
         self.extra_yaw = 0.0  # [rad] added to the IMU heading (a slip odometry cannot see)
         self.sag = 0.0  # [rad] how far short of its set point the loaded swivel settles
         self.speed = 0.0  # [m/s] forward, as the drive makes it (no inertia)
@@ -45,7 +46,7 @@ class KinematicCar:
             swivel=self.swivel, swivel_rate=self.rate, set_point=self.set_point,
             torque=10.0 * self.swivel,
             pitch=-float(kinematics.lift_angle(self.p, self.swivel)) + self.extra_pitch,
-            roll=0.0, imu_yaw=self.odometry.yaw + self.extra_yaw, speed=self.speed)
+            roll=self.roll, imu_yaw=self.odometry.yaw + self.extra_yaw, speed=self.speed)
 
     def apply(self, command: Command) -> None:
         """Follow ``command`` for one control period."""

@@ -141,13 +141,31 @@ def test_the_rear_axle_climbs_with_the_swivel_free_and_stops_held():
     assert machine.outcome.success and not car.commands[-1].free
 
 
-def test_front_coming_down_before_the_rear_reaches_the_edge_ends_failed():
+def in_the_rear_step_with_the_front_up() -> tuple[ClimbStateMachine, KinematicCar]:
     machine, _ = start()
     car = KinematicCar()
     run(machine, car, until=lambda m, c: m.step == Step.REAR)
     car.extra_pitch = -0.1  # front on the step
     car.apply(machine.update(car.observe()))
+    return machine, car
+
+
+def test_front_coming_down_before_the_rear_reaches_the_edge_ends_failed():
+    machine, car = in_the_rear_step_with_the_front_up()
     car.extra_pitch = 0.0  # level again, the rear wheels still well before the edge
+    car.apply(machine.update(car.observe()))
+    assert_safe_abort(machine, car, ErrorCode.FAILED)
+    assert 'came down' in machine.outcome.message
+
+
+def test_one_rear_wheel_up_is_not_taken_for_the_front_coming_down():
+    # Measured in the sim: with one rear wheel on a 4 cm step the pitch halves, the car
+    # rolls 0.13 rad, and odometry still puts the rear axle 0.08 m short of the edge.
+    machine, car = in_the_rear_step_with_the_front_up()
+    car.extra_pitch, car.roll = 0.0, 0.13
+    car.apply(machine.update(car.observe()))
+    assert machine.outcome is None and machine.step == Step.REAR
+    car.roll = 0.0  # level and not rolled: the front came down after all
     car.apply(machine.update(car.observe()))
     assert_safe_abort(machine, car, ErrorCode.FAILED)
     assert 'came down' in machine.outcome.message
