@@ -23,10 +23,11 @@ x forward, y left, z up)::
 Mass layout and drive train. The defaults match the thesis' I_s = 0.84 kg m^2 with the heavy
 parts in the rear axle housing (centre of mass at 24 % of the wheelbase), open differentials
 and a 10 N m drive: the car turns and its odometry is as the thesis models it, and the whole
-car climbs 6 cm. ``config/designs/climbing.yaml`` moves the weight forward and locks both
-differentials (docs/climbing_design.md): the swivel lifts whichever axle is lighter, and once
-the front is on the step the rear axle climbs by traction, which wants weight on the front
-wheels; with the free rear phase it climbs no higher (6 cm).
+car climbs 6 cm. ``config/designs/climbing.yaml`` moves the weight forward (centre of mass at
+47 %) with a 20 N m drive (docs/climbing_design.md): the swivel lifts whichever axle is
+lighter, and once the front is on the step the rear axle climbs by traction, which wants
+weight on the front wheels; it climbs 7 cm (8 cm in 89 % of benchmark climbs), but on flat
+ground its swivel lifts a rear wheel, so it does not steer as the thesis models.
 
 Swivel gains. Thesis Table 2 (kp 19 N m/rad, ki 11.45 N m/(rad s), kd 5.5 N m s/rad, the
 documented starting point and ``SwivelCarParams``' defaults) is far too soft for the simulated
