@@ -37,7 +37,7 @@ from swivel_car_model.description import CarDescription
 from swivel_car_planner.core import ClimbRequest, ErrorCode
 from swivel_car_planner.core.capability import CapabilityTable, description_values, RELIABLE
 
-from swivel_car_bringup.inprocess import InProcessStack
+from swivel_car_bringup.inprocess import InProcessStack, StackConfig
 
 _NOT_ATTEMPTED = (ErrorCode.INVALID_REQUEST,)
 _REFUSED = (ErrorCode.UNREACHABLE_HEIGHT, ErrorCode.TIP_OVER, ErrorCode.TORQUE_LIMIT,
@@ -79,11 +79,10 @@ def sign_changes(torque: np.ndarray, threshold: float = _CHATTER_TORQUE) -> int:
     return int(np.count_nonzero(signs[1:] != signs[:-1]))
 
 
-def run_swivel(args: argparse.Namespace, robot: dict, rng: random.Random) -> list[Trial]:
+def run_swivel(args: argparse.Namespace, config: StackConfig,
+               rng: random.Random) -> list[Trial]:
     trials = []
-    planner = {'capability_file': 'none', **_assignments(args.planner)}
-    with InProcessStack(robot=robot, planner=planner,
-                        controller=_assignments(args.controller)) as stack:
+    with InProcessStack(config=config) as stack:
         for height in _heights(args):
             attempted = drawn = 0
             while attempted < args.trials and drawn < args.trials * args.max_draws:
@@ -276,11 +275,17 @@ def main(argv: list[str] | None = None) -> None:
                         help='write the whole-car capability table the planner ships')
     args = parser.parse_args(argv)
     robot = _robot(args)
-    description = CarDescription().replace(**robot) if robot else CarDescription()
+    try:  # every override checked before the first climb
+        description = CarDescription.from_values(robot)
+        config = StackConfig.installed(
+            robot=robot, controller=_assignments(args.controller),
+            planner={'capability_file': 'none', **_assignments(args.planner)})
+    except ValueError as error:
+        parser.error(str(error))
     rng = random.Random(args.seed)
     started = time.monotonic()
     print(f'swivel car: {args.trials} attempted climbs per height, seed {args.seed}')
-    trials = run_swivel(args, robot, rng)
+    trials = run_swivel(args, config, rng)
     car_like = {} if args.skip_car_like else run_car_like(args, robot)
     report(trials, car_like, description)
     if args.write_capability:

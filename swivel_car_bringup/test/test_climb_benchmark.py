@@ -4,11 +4,12 @@ from pathlib import Path
 
 from ament_index_python.packages import get_package_share_directory
 import numpy as np
+import pytest
 
 from swivel_car_model.description import CarDescription
 from swivel_car_planner.core.capability import CapabilityTable
 
-from swivel_car_bringup.climb_benchmark import design_values, heights, sign_changes
+from swivel_car_bringup.climb_benchmark import design_values, heights, main, sign_changes
 
 
 def test_sign_changes_ignore_the_band_around_zero():
@@ -30,3 +31,16 @@ def test_the_climbing_design_ships_with_a_table_measured_on_it():
     assert table.matches(description)
     assert not table.matches(CarDescription())
     assert table.limit >= 0.07
+
+
+@pytest.mark.parametrize('option, message', [
+    ('--set=bogus=2', 'unknown robot description parameter'),
+    ('--set=body_mass=heavy', 'body_mass'),
+    ('--controller=bogus=1', 'unknown controller parameter'),
+    ('--planner=rear_speed=-1', 'rear_speed must be >= 0')])
+def test_a_bad_override_is_a_usage_error_before_any_climb(option, message, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(['--heights', '0.02', '--trials', '1', '--skip-car-like', option])
+    assert exit_.value.code == 2
+    out, err = capsys.readouterr()
+    assert message in err and 'attempted climbs' not in out
