@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import sys
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -27,18 +27,23 @@ from rclpy.action import ActionClient
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from sensor_msgs.msg import JointState
 from swivel_car_msgs.action import ClimbStep
-from swivel_car_msgs.msg import StepObstacle, SwivelControllerState
+from swivel_car_msgs.msg import StepObstacle
 from swivel_car_msgs.srv import SpawnObstacle
 from swivel_car_planner.core import capability
 
-from demo_report import write_report
+from demo_report import read_bag, Recording, write_report
 from swivel_car_sim.physics import StepSpec
-from swivel_car_stack import REPO_ROOT, lockstep_parameters, spin_until, start_node
+from swivel_car_stack import (
+    NodeProcess, REPO_ROOT, lockstep_parameters, spin_until, start_node)
 
 NODES = (('swivel_car_sim', 'sim_node'), ('swivel_car_control', 'controller_node'),
          ('swivel_car_control', 'odometry_node'), ('swivel_car_planner', 'planner_node'))
+# What the recorder must have subscribed to before the demo moves (it records every topic;
+# the report is drawn from the bag).
+RECORDED = ('/clock', '/joint_states', '/ground_truth/odom', '/odom',
+            '/controller/controller_state', '/cmd_vel', '/robot_description',
+            '/climb_step/_action/feedback')
 
 # Lockstep: the physics advances only when the controller has answered, and the controller
 # takes the planner's commands in step, so the climb does not depend on how busy the machine
@@ -49,19 +54,6 @@ NODE_PARAMETERS = {executable: {'use_sim_time': True,
                                 **lockstep_parameters(executable, LOCKSTEP_TIMEOUT)}
                    for _, executable in NODES}
 NODE_PARAMETERS['sim_node']['gui'] = False
-
-
-@dataclass
-class Recording:
-    """Time series collected from the stack's topics, stamped in sim time."""
-
-    truth: list[tuple[float, float, float, float, float, float, float, float]] = field(
-        default_factory=list)  # t [s], x, y, z [m], quaternion x, y, z, w
-    odom: list[tuple[float, float, float]] = field(default_factory=list)  # t, x, y
-    joints: list[tuple[float, np.ndarray]] = field(default_factory=list)  # t, positions [rad]
-    control: list[tuple[float, float, float, float, float]] = field(
-        default_factory=list)  # t, set point, measured [rad], rate [rad/s], torque [N m]
-    joint_names: tuple[str, ...] = ()
 
 
 def stamp_seconds(stamp) -> float:
@@ -77,12 +69,15 @@ class DemoNode(Node):
         self.recording = Recording()
         self.create_subscription(Odometry, 'ground_truth/odom', self._on_truth, 100)
         self.create_subscription(Odometry, 'odom', self._on_odom, 100)
-        self.create_subscription(JointState, 'joint_states', self._on_joints, 100)
-        self.create_subscription(SwivelControllerState, 'controller/controller_state',
-                                 self._on_control, 100)
         self.cmd_vel = self.create_publisher(TwistStamped, 'cmd_vel', 10)
         self.spawn = self.create_client(SpawnObstacle, 'sim/spawn_obstacle')
         self.climb = ActionClient(self, ClimbStep, 'climb_step')
+
+    def recorded(self, topics) -> bool:
+        """Whether the recorder subscribes to every one of ``topics``."""
+        return all(any(info.node_name == 'recorder'
+                       for info in self.get_subscriptions_info_by_topic(topic))
+                   for topic in topics)
 
     def _on_truth(self, msg: Odometry) -> None:
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
@@ -93,18 +88,10 @@ class DemoNode(Node):
         p = msg.pose.pose.position
         self.recording.odom.append((stamp_seconds(msg.header.stamp), p.x, p.y))
 
-    def _on_joints(self, msg: JointState) -> None:
-        self.recording.joint_names = tuple(msg.name)
-        self.recording.joints.append((stamp_seconds(msg.header.stamp), np.array(msg.position)))
-
-    def _on_control(self, msg: SwivelControllerState) -> None:
-        self.recording.control.append((stamp_seconds(msg.header.stamp), msg.set_point,
-                                       msg.measured, msg.measured_rate, msg.torque))
-
     def drive(self, speed: float) -> None:
         msg = TwistStamped()
         # A zero stamp: the controller stamps the command on receipt, so a moment's lag of
-        # the demo (it records four topics at 100 Hz) cannot make it look stale.
+        # the demo (it follows two topics at 100 Hz) cannot make it look stale.
         msg.header.frame_id = 'base_link'
         msg.twist.linear.x = speed
         self.cmd_vel.publish(msg)
@@ -151,8 +138,15 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
     was recorded."""
     domain_id = args.domain_id
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    processes = [start_node(package, executable, domain_id, NODE_PARAMETERS[executable])
-                 for package, executable in NODES]
+    # Beside the stack, as `stack.launch.py record:=true` starts them: the robot model on the
+    # graph and the recorder.
+    shutil.rmtree(args.report / 'bag', ignore_errors=True)
+    processes = [NodeProcess('swivel_car_bringup', 'recorder_node', domain_id, {
+        'use_sim_time': True, 'output': str(args.report / 'bag'), 'discovery_period': 0.2}),
+                 NodeProcess('swivel_car_bringup', 'robot_description_node', domain_id,
+                             {'use_sim_time': True})]
+    processes += [start_node(package, executable, domain_id, NODE_PARAMETERS[executable])
+                  for package, executable in NODES]
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)
     node = DemoNode(context)
@@ -166,10 +160,11 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
                     raise DemoError(f'{process.name} exited:\n{process.output()[-3000:]}')
             return False
 
-        progress.show('start', 'the stack: sim, controller, odometry, planner')
+        progress.show('start', 'the stack: sim, controller, odometry, planner, recorder')
         spin_until(executor, lambda: check_alive() or (
             node.spawn.service_is_ready() and node.climb.server_is_ready()
-            and node.recording.odom), 90.0, 'the stack to come up')
+            and node.recording.odom and node.recorded(RECORDED)), 90.0,
+            'the stack and the recorder to come up')
 
         step = demo_step(args)
         obstacle = StepObstacle(name=step.name, height=step.height, depth=step.depth,
@@ -217,8 +212,6 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
         result = result_future.result().result
         progress.done()
         climb_end = node.recording.truth[-1][0]
-        return summarise(args, node.recording, result, climb_start, climb_end,
-                         time.monotonic() - wall_start), node.recording
     finally:
         executor.shutdown()
         node.destroy_node()
@@ -227,6 +220,9 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
         failed = {name: code for name, code in codes.items() if code not in (0, -2)}
         if failed:
             print(f'warning: nodes exited with {failed}', file=sys.stderr)
+    recording = read_bag(args.report / 'bag')
+    return summarise(args, recording, result, climb_start, climb_end,
+                     time.monotonic() - wall_start), recording
 
 
 def summarise(args, recording: Recording, result, climb_start: float, climb_end: float,

@@ -1,8 +1,10 @@
 """The demo's report: plots of what the stack did and frames of the climb rendered by
-pybullet's own renderer, in one markdown page beside its PNGs."""
+pybullet's own renderer, in one markdown page beside its PNGs, all drawn from the run's
+rosbag2 bag (read with rosbags, from the message definitions in the bag)."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import matplotlib
@@ -10,10 +12,52 @@ import matplotlib
 matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from rosbags.highlevel import AnyReader  # noqa: E402
 from swivel_car_model.params import SwivelCarParams  # noqa: E402
 from swivel_car_sim.physics import SimConfig, StepSpec, SwivelCarSim  # noqa: E402
 
 FRAME_COUNT = 8
+
+
+@dataclass
+class Recording:
+    """Time series of the stack's topics, stamped in sim time."""
+
+    truth: list[tuple[float, float, float, float, float, float, float, float]] = field(
+        default_factory=list)  # t [s], x, y, z [m], quaternion x, y, z, w
+    odom: list[tuple[float, float, float]] = field(default_factory=list)  # t, x, y
+    joints: list[tuple[float, np.ndarray]] = field(default_factory=list)  # t, positions [rad]
+    control: list[tuple[float, float, float, float, float]] = field(
+        default_factory=list)  # t, set point, measured [rad], rate [rad/s], torque [N m]
+    joint_names: tuple[str, ...] = ()
+
+
+def _seconds(header) -> float:
+    return header.stamp.sec + 1e-9 * header.stamp.nanosec
+
+
+def read_bag(path: Path) -> Recording:
+    """The report's time series from a bag the recorder wrote."""
+    recording = Recording()
+    with AnyReader([path]) as reader:
+        wanted = [c for c in reader.connections if c.topic in (
+            '/ground_truth/odom', '/odom', '/joint_states', '/controller/controller_state')]
+        for connection, _, data in reader.messages(connections=wanted):
+            msg = reader.deserialize(data, connection.msgtype)
+            t = _seconds(msg.header)
+            if connection.topic == '/ground_truth/odom':
+                p, q = msg.pose.pose.position, msg.pose.pose.orientation
+                recording.truth.append((t, p.x, p.y, p.z, q.x, q.y, q.z, q.w))
+            elif connection.topic == '/odom':
+                p = msg.pose.pose.position
+                recording.odom.append((t, p.x, p.y))
+            elif connection.topic == '/joint_states':
+                recording.joint_names = tuple(msg.name)
+                recording.joints.append((t, np.array(msg.position)))
+            else:
+                recording.control.append((t, msg.set_point, msg.measured, msg.measured_rate,
+                                          msg.torque))
+    return recording
 
 
 def _pitch(quaternions: np.ndarray) -> np.ndarray:
@@ -130,8 +174,9 @@ def write_report(summary: dict, recording, step: StepSpec, folder: Path) -> Path
     page.write_text(f"""# Swivel car demo: driving to a step and climbing it
 
 The stack ran as four processes (`sim_node`, `controller_node`, `odometry_node`,
-`planner_node`) on sim time in lockstep; the demo drove with `cmd_vel` and called the
-`climb_step` action. Shaded: while the climb ran.
+`planner_node`) on sim time in lockstep, beside `robot_description_node` and `recorder_node`;
+the demo drove with `cmd_vel` and called the `climb_step` action. Everything below is drawn
+from the run's recording, [`bag/`](bag) (rosbag2, MCAP storage). Shaded: while the climb ran.
 
 | | |
 |---|---|
@@ -149,5 +194,15 @@ The swivel turned furthest:
 
 ## Swivel angle, pitch, swivel torque and energy
 ![time series](time_series.png)
+
+## Opening the recording
+`bag/` holds every topic of the run (`/clock` included, sim time) with the message
+definitions, so no swivel_car package is needed to read it:
+- Foxglove: "Open local file", `report/bag/bag.mcap`; in the 3D panel add a URDF layer from
+  the topic `/robot_description`, with `base_link` as the display frame (the link frames need
+  `/tf`: with tf2_msgs installed `robot_description_node` records them; the live bridge,
+  `foxglove_bridge_node`, sends them itself on `/robot_frames`).
+- A full ROS 2 Jazzy install: `ros2 bag info report/bag`, `ros2 bag play report/bag --clock`.
+- Python: `rosbags` (`AnyReader`) or `mcap` with `mcap-ros2-support`.
 """)
     return page

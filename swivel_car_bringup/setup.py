@@ -1,3 +1,5 @@
+from glob import glob
+
 from setuptools import find_packages, setup
 
 package_name = 'swivel_car_bringup'
@@ -9,14 +11,20 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml', 'README.md']),
+        ('share/' + package_name + '/launch', glob('launch/*.launch.py')),
     ],
     install_requires=['setuptools'],
     zip_safe=True,
     maintainer='Swivel car team',
     maintainer_email='team@swivel-car.invalid',
-    description='The swivel car stack wired in one process, without ROS, for design campaigns.',
+    description='The whole stack: launch, recording, the robot on the graph, a live view; and '
+                'the stack wired in one process, without ROS, for design campaigns.',
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [],
+        'console_scripts': [
+            'recorder_node = swivel_car_bringup.recorder_node:main',
+            'robot_description_node = swivel_car_bringup.robot_description_node:main',
+            'foxglove_bridge_node = swivel_car_bringup.foxglove_bridge_node:main',
+        ],
     },
 )

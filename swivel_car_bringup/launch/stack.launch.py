@@ -1,0 +1,64 @@
+"""The whole stack: sim, controller, odometry, planner and the robot on the graph, optionally a
+recording and a live view (for a full Jazzy install with launch_ros).
+
+ros2 launch swivel_car_bringup stack.launch.py [record:=true] [bag:=my_run]
+    [foxglove:=true] [foxglove_port:=8765] [gui:=true] [robot_variant:=swivel]
+"""
+
+import os
+
+from ament_index_python.packages import get_package_share_directory
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, IncludeLaunchDescription
+from launch.conditions import IfCondition
+from launch.launch_description_sources import PythonLaunchDescriptionSource
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+from launch_ros.parameter_descriptions import ParameterValue
+
+
+def _include(package: str, launch_file: str, arguments: dict) -> IncludeLaunchDescription:
+    return IncludeLaunchDescription(
+        PythonLaunchDescriptionSource(os.path.join(
+            get_package_share_directory(package), 'launch', launch_file)),
+        launch_arguments=arguments.items())
+
+
+def generate_launch_description() -> LaunchDescription:
+    use_sim_time = {'use_sim_time': ParameterValue(LaunchConfiguration('use_sim_time'),
+                                                   value_type=bool)}
+    sim_time_argument = {'use_sim_time': LaunchConfiguration('use_sim_time')}
+    return LaunchDescription([
+        DeclareLaunchArgument('use_sim_time', default_value='true',
+                              description='run on the sim clock (/clock)'),
+        DeclareLaunchArgument('gui', default_value='false',
+                              description='open the pybullet window'),
+        DeclareLaunchArgument('robot_variant', default_value='swivel',
+                              description='swivel | car_like'),
+        DeclareLaunchArgument('record', default_value='false',
+                              description='record every topic into a rosbag2 bag (MCAP)'),
+        DeclareLaunchArgument('bag', default_value='',
+                              description="bag directory; '' = rosbag2_<date>_<time>"),
+        DeclareLaunchArgument('foxglove', default_value='false',
+                              description='serve the topics to Foxglove over WebSocket'),
+        DeclareLaunchArgument('foxglove_port', default_value='8765',
+                              description='port of the Foxglove WebSocket server'),
+        _include('swivel_car_sim', 'sim.launch.py', {
+            **sim_time_argument, 'gui': LaunchConfiguration('gui'),
+            'robot_variant': LaunchConfiguration('robot_variant')}),
+        _include('swivel_car_control', 'control.launch.py', sim_time_argument),
+        _include('swivel_car_planner', 'planner.launch.py', sim_time_argument),
+        Node(package='swivel_car_bringup', executable='robot_description_node',
+             name='robot_description', output='screen',
+             parameters=[{**use_sim_time, 'robot_variant': ParameterValue(
+                 LaunchConfiguration('robot_variant'), value_type=str)}]),
+        Node(package='swivel_car_bringup', executable='recorder_node', name='recorder',
+             output='screen', condition=IfCondition(LaunchConfiguration('record')),
+             parameters=[{**use_sim_time, 'output': ParameterValue(
+                 LaunchConfiguration('bag'), value_type=str)}]),
+        Node(package='swivel_car_bringup', executable='foxglove_bridge_node',
+             name='foxglove_bridge', output='screen',
+             condition=IfCondition(LaunchConfiguration('foxglove')),
+             parameters=[{**use_sim_time, 'port': ParameterValue(
+                 LaunchConfiguration('foxglove_port'), value_type=int)}]),
+    ])

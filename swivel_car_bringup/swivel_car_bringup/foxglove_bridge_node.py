@@ -1,0 +1,153 @@
+"""foxglove_bridge_node: a live view of the stack in Foxglove, without RViz or a ROS install
+on the viewing machine. Serves every topic of the graph (as they appear) over Foxglove's
+WebSocket protocol with the Foxglove SDK, as ``ros2msg`` schemas and CDR messages, the way the
+recorder writes them, so a bag and the live view open alike. Adds ``/robot_frames``
+(foxglove.FrameTransforms: odom -> base_link from ``odom`` and every link from
+``joint_states``), so the 3D panel shows the car from ``robot_description`` where tf2_msgs is
+missing.
+
+Open Foxglove, "Open connection", ``ws://localhost:8765``.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import foxglove
+from ament_index_python.packages import get_package_share_directory
+from foxglove import Channel, Schema
+from foxglove.channels import FrameTransformsChannel
+from foxglove.messages import FrameTransform, FrameTransforms, Quaternion, Timestamp, Vector3
+from foxglove.websocket import ChannelView, Client
+from nav_msgs.msg import Odometry
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import JointState
+from std_msgs.msg import String
+
+from swivel_car_bringup.bag import MessageDefinitions, UnknownTypeError
+from swivel_car_bringup.robot_frames import fixed_frames, Frame, moving_frames, parse_joints
+from swivel_car_bringup.topics import message_class, subscription_qos, TopicWatcher
+from swivel_car_control.ros_params import refuse_runtime_changes, run_node
+
+PARAMETERS = {
+    'host': ('127.0.0.1', "address to serve on; '0.0.0.0' for other machines"),
+    'port': (8765, 'WebSocket port'),
+    'discovery_period': (0.5, 'how often the graph is searched for new topics [s] wall'),
+}
+FRAMES_TOPIC = '/robot_frames'
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+def _foxglove_transform(frame: Frame, stamp) -> FrameTransform:
+    return FrameTransform(timestamp=Timestamp(sec=stamp.sec, nsec=stamp.nanosec),
+                          parent_frame_id=frame.parent, child_frame_id=frame.child,
+                          translation=Vector3(x=frame.translation[0], y=frame.translation[1],
+                                              z=frame.translation[2]),
+                          rotation=Quaternion(x=frame.rotation[0], y=frame.rotation[1],
+                                              z=frame.rotation[2], w=frame.rotation[3]))
+
+
+class _Latching:
+    """Sends the last message of a latched (transient local) topic to each new subscriber,
+    as a ROS late subscriber would get it."""
+
+    def __init__(self) -> None:
+        self.last: dict[int, tuple[Channel, bytes, int]] = {}
+
+    def on_subscribe(self, client: Client, channel: ChannelView) -> None:
+        if channel.id in self.last:
+            stored, data, log_time = self.last[channel.id]
+            stored.log(data, log_time=log_time)
+
+
+class FoxgloveBridgeNode(Node):
+    """The Foxglove WebSocket bridge; see the bringup package README."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('foxglove_bridge', **kwargs)
+        values = {name: self.declare_parameter(
+            name, default, ParameterDescriptor(description=text)).value
+            for name, (default, text) in PARAMETERS.items()}
+        refuse_runtime_changes(self, set(PARAMETERS))
+        if not 0 <= values['port'] <= 65535:
+            raise ValueError(f'port must be in 0..65535, got {values["port"]}')
+        self._definitions = MessageDefinitions(get_package_share_directory)
+        self._latching = _Latching()
+        try:
+            self._server = foxglove.start_server(
+                name='swivel_car', host=values['host'], port=values['port'],
+                server_listener=self._latching)
+        except RuntimeError as error:
+            raise ValueError(f'cannot serve on {values["host"]}:{values["port"]}: {error}') \
+                from None
+        self._channels: list[Channel] = []
+        self._frames = FrameTransformsChannel(FRAMES_TOPIC)
+        self._joints: list = []
+        self._static_frames: list[Frame] = []
+        self.create_subscription(String, 'robot_description', self._on_description, LATCHED)
+        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
+        self.create_subscription(Odometry, 'odom', self._on_odom, 10)
+        TopicWatcher(self, self._on_topic, values['discovery_period'])
+        self.get_logger().info(f'Foxglove: open ws://{values["host"]}:{self._server.port}')
+
+    def _on_topic(self, topic: str, type_name: str, publishers: list) -> None:
+        try:
+            msg_class = message_class(type_name)
+            msgdef, _ = self._definitions.definition(type_name)
+        except (LookupError, UnknownTypeError) as error:
+            self.get_logger().error(f'not serving {topic}: {error}')
+            return
+        channel = Channel(topic, message_encoding='cdr', schema=Schema(
+            name=type_name, encoding='ros2msg', data=msgdef.encode()))
+        self._channels.append(channel)
+        qos = subscription_qos(publishers)
+        latched = qos.durability == DurabilityPolicy.TRANSIENT_LOCAL
+
+        def forward(data: bytes) -> None:
+            log_time = self.get_clock().now().nanoseconds
+            channel.log(data, log_time=log_time)
+            if latched:
+                self._latching.last[channel.id()] = (channel, data, log_time)
+
+        self.create_subscription(msg_class, topic, forward, qos, raw=True)
+        self.get_logger().info(f'serving {topic} ({type_name})')
+
+    def _on_description(self, msg: String) -> None:
+        try:
+            self._joints = parse_joints(msg.data)
+        except ValueError as error:
+            self.get_logger().error(f'robot_description is not a URDF ({error}): no link '
+                                    f'frames on {FRAMES_TOPIC}')
+            return
+        self._static_frames = fixed_frames(self._joints)
+
+    def _on_joint_states(self, msg: JointState) -> None:
+        frames = self._static_frames + moving_frames(self._joints,
+                                                     dict(zip(msg.name, msg.position)))
+        self._log_frames(frames, msg.header.stamp)
+
+    def _on_odom(self, msg: Odometry) -> None:
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        self._log_frames([Frame(msg.header.frame_id, msg.child_frame_id, (p.x, p.y, p.z),
+                                (q.x, q.y, q.z, q.w))], msg.header.stamp)
+
+    def _log_frames(self, frames: list[Frame], stamp) -> None:
+        if frames:
+            self._frames.log(
+                FrameTransforms(transforms=[_foxglove_transform(f, stamp) for f in frames]),
+                log_time=stamp.sec * 1_000_000_000 + stamp.nanosec)
+
+    def destroy_node(self) -> None:
+        self._server.stop()
+        super().destroy_node()
+
+
+def main(args=None) -> None:
+    sys.exit(run_node(FoxgloveBridgeNode, 'foxglove_bridge', args))
+
+
+if __name__ == '__main__':
+    main()
