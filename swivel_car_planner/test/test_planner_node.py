@@ -114,16 +114,20 @@ class Rig:
     def drive(self, future, seconds=120.0):
         """Close the loop until ``future`` is done: the car follows the planner's commands.
 
-        Lockstep by hand: each cycle waits (briefly) for the planner's command of that cycle;
-        until a climb is registered there is none, and the car keeps the last one.
+        Lockstep by hand: each cycle waits for the planner's command of that cycle. Until a
+        climb is registered there is none (a short wait, then the car keeps the last one);
+        from its first command on the planner answers every state, so the wait is only a
+        guard and a loaded machine cannot put the car out of step with the planner.
         """
         last = Command(0.0, 0.0, 0.0, False)
+        answering = False
         while not future.done() and self.car.time < seconds:
             self.publish_state()
-            deadline = time.monotonic() + 0.5
+            deadline = time.monotonic() + (10.0 if answering else 0.5)
             while self.command is None and not future.done() and time.monotonic() < deadline:
                 self.executor.spin_once(timeout_sec=0.005)
             if self.command is not None:
+                answering = True
                 # A release leaves the swivel where it was and stops, as the controller does.
                 last = self.command if self.command.hold else Command(last.angle, 0.0, 0.0, False)
                 self.command = None

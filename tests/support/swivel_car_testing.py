@@ -7,20 +7,48 @@ Import from any test (the root pytest.ini puts tests/support and scripts on sys.
 
 from __future__ import annotations
 
+import fcntl
 import itertools
 import os
+import tempfile
+from pathlib import Path
+from typing import IO
 
 from swivel_car_stack import (  # noqa: F401  (re-exported for the tests)
     INSTALL_DIR, REPO_ROOT, NodeProcess, config_path, executable_path, lockstep_parameters,
     ros_environment, spin_until, start_node)
 
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
-# stragglers are never heard. The base spreads concurrent pytest processes apart.
-_DOMAIN_BASE = 1 + (os.getpid() % 23) * 10  # ROS_DOMAIN_ID 1 .. 230
-_DOMAIN_IDS = itertools.cycle(range(_DOMAIN_BASE, _DOMAIN_BASE + 10))
+# stragglers are never heard. Every process (a pytest-xdist worker, another pytest, the
+# benchmark) claims a block of ten ids of its own with a lock file on this host, held until it
+# exits; the search starts at a block chosen by the pid, so a block left by a process that
+# just ended (perhaps with stragglers) is rarely the next one taken.
+_BLOCKS = 23  # ROS_DOMAIN_ID 1 .. 230 (Fast DDS allows at most 232)
+_LOCK_DIR = Path(tempfile.gettempdir()) / 'swivel_car_ros_domains'
+_held: list[IO[str]] = []
+_domain_ids: itertools.cycle | None = None
+
+
+def _claim_block() -> int:
+    _LOCK_DIR.mkdir(exist_ok=True)
+    for k in range(_BLOCKS):
+        block = (os.getpid() + k) % _BLOCKS
+        lock = open(_LOCK_DIR / f'{block}.lock', 'w')
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            lock.close()
+            continue
+        _held.append(lock)
+        return block
+    return os.getpid() % _BLOCKS  # more than 23 processes at once: share one block
 
 
 def next_domain_id() -> int:
-    """A ROS_DOMAIN_ID not used by the previous nine calls in this process."""
-    return next(_DOMAIN_IDS)
-
+    """A ROS_DOMAIN_ID that no other process using this helper on this host has, and not
+    used by the previous nine calls in this process."""
+    global _domain_ids
+    if _domain_ids is None:
+        base = 1 + 10 * _claim_block()
+        _domain_ids = itertools.cycle(range(base, base + 10))
+    return next(_domain_ids)
