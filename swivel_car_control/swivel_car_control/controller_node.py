@@ -20,7 +20,7 @@ from swivel_car_control.core.controller import ControllerConfig, SwivelControlle
 from swivel_car_control.core.joint_states import JointStateController
 from swivel_car_control.joints import MissingJointError
 from swivel_car_control.ros_params import (
-    declare_dataclass, declare_description, refuse_runtime_changes, run_node)
+    declare_dataclass, declare_description, live_parameters, run_node)
 
 # A cmd_vel stamped further than this ahead of the node clock is taken as arriving now.
 _CLOCK_SLACK = 0.5  # [s]
@@ -28,8 +28,6 @@ _CLOCK_SLACK = 0.5  # [s]
 CONFIG_DESCRIPTIONS = {
     'max_integral_torque': 'clamp on the PID integral contribution [N m]',
     'integral_band': 'the PID integrates only while |error| is below this [rad]',
-    'swivel_limit': 'largest |swivel set point|, <= max_swivel_angle; reduced further to keep '
-                    'the tip-over rule [rad]',
     'max_swivel_rate': 'swivel set-point rate limit [rad/s]',
     'max_linear_velocity': 'forward speed limit of base_link [m/s]',
     'max_linear_acceleration': 'forward acceleration limit [m/s^2]',
@@ -56,28 +54,32 @@ class ControllerNode(Node):
                                    given={'max_torque': robot.swivel_torque_limit})
         self._use_stamped = self.declare_parameter(
             'use_stamped', True, ParameterDescriptor(
-                description='cmd_vel is geometry_msgs/TwistStamped (true) or Twist')).value
+                description='cmd_vel is geometry_msgs/TwistStamped (true) or Twist',
+                read_only=True)).value
         swivel_joint = self.declare_parameter(
             'swivel_joint', 'swivel_joint',
-            ParameterDescriptor(description='name of the swivel joint in joint_states')).value
+            ParameterDescriptor(description='name of the swivel joint in joint_states',
+                                read_only=True)).value
         self._lockstep_swivel_command = self.declare_parameter(
             'lockstep_swivel_command', False, ParameterDescriptor(
                 description='lockstep sim with a stamped swivel_command stream (the planner): '
                             'answer each joint_states only once the command answering the '
                             'previous one has come, so climbs do not depend on machine '
-                            'load')).value
+                            'load', read_only=True)).value
         self._lockstep_wait = self.declare_parameter(
             'lockstep_wait', 0.05, ParameterDescriptor(
                 description='longest wall-time wait for that command; then answer without '
                             'it and wait no more until the next command; keep it below the '
-                            "sim's lockstep_timeout [s]")).value
-        if not (math.isfinite(self._lockstep_wait) and self._lockstep_wait > 0.0):
+                            "sim's lockstep_timeout [s]", dynamic_typing=True,
+                read_only=True)).value
+        if not (isinstance(self._lockstep_wait, (int, float))
+                and not isinstance(self._lockstep_wait, bool)
+                and math.isfinite(self._lockstep_wait) and self._lockstep_wait > 0.0):
             raise ValueError(f'lockstep_wait must be > 0 s, got {self._lockstep_wait!r}')
-        refuse_runtime_changes(self, {f.name for f in dataclasses.fields(robot)}
-                               | set(CONFIG_DESCRIPTIONS)
-                               | {'use_stamped', 'swivel_joint', 'lockstep_swivel_command',
-                                  'lockstep_wait'})
         self._core = SwivelController(car, config)
+        live_parameters(self, ControllerConfig.LIVE,
+                        lambda changes: dataclasses.replace(self._core.config, **changes),
+                        self._core.reconfigure)
         self._joint_states = JointStateController(self._core, swivel_joint)
         self._warned_zero_stamp = False
         self._heard_command_time = -math.inf  # [s] stamp of the last stamped swivel_command

@@ -7,6 +7,7 @@ import dataclasses
 import math
 import sys
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import Odometry
@@ -17,9 +18,11 @@ from swivel_car_msgs.srv import SetPose2D
 
 from swivel_car_control.conversions import stamp_to_seconds, yaw_to_quaternion
 from swivel_car_control.core.joint_states import JointStateOdometry, YAW_RATE_SOURCES
+from swivel_car_control.core.odometry_input import (
+    GatedOdometry, MAX_SWIVEL_RATE, Verdict, WHEEL_RATE_FACTOR)
 from swivel_car_control.joints import MissingJointError
 from swivel_car_control.ros_params import (
-    declare_dataclass, declare_description, refuse_runtime_changes, run_node)
+    declare_dataclass, declare_description, live_parameters, run_node)
 
 
 @dataclass(frozen=True)
@@ -39,6 +42,8 @@ class OdometryConfig:
     rear_left_wheel_joint: str = 'rear_left_wheel_joint'
     rear_right_wheel_joint: str = 'rear_right_wheel_joint'
     yaw_rate_source: str = 'swivel'
+    # What the node applies while running; the rest is read-only.
+    LIVE: ClassVar[tuple[str, ...]] = ('pose_covariance_diagonal', 'twist_covariance_diagonal')
 
     def __post_init__(self) -> None:
         if self.yaw_rate_source not in YAW_RATE_SOURCES:
@@ -96,20 +101,37 @@ class OdometryNode(Node):
         robot = declare_description(self)
         self._car = robot.model_params()
         self._config = config = declare_dataclass(self, OdometryConfig, CONFIG_DESCRIPTIONS)
-        refuse_runtime_changes(self, {f.name for f in dataclasses.fields(robot)}
-                               | {f.name for f in dataclasses.fields(config)})
-        self._joint_odometry = JointStateOdometry(
+        joint_odometry = JointStateOdometry(
             self._car, config.swivel_joint, config.rear_left_wheel_joint,
             config.rear_right_wheel_joint, config.yaw_rate_source, config.publish_rate)
-        self._odometry = self._joint_odometry.odometry
+        self._odometry = joint_odometry.odometry
+        max_wheel_rate = WHEEL_RATE_FACTOR * robot.drive_speed_limit  # [rad/s]
+        self._gated = GatedOdometry(joint_odometry, {
+            config.swivel_joint: MAX_SWIVEL_RATE, config.rear_left_wheel_joint: max_wheel_rate,
+            config.rear_right_wheel_joint: max_wheel_rate})
         self._tf = self._make_tf_broadcaster() if config.enable_odom_tf else None
 
-        self._pose_covariance = _diagonal(config.pose_covariance_diagonal)
-        self._twist_covariance = _diagonal(config.twist_covariance_diagonal)
+        self._apply_config(config)
+        live_parameters(self, OdometryConfig.LIVE, self._live_config, self._apply_config)
         self._odom_pub = self.create_publisher(Odometry, 'odom', 10)
-        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
+        # Outside the lockstep chain the odometry may trail a busy sim: a second of states
+        # queued, so it integrates every one instead of dropping them and Euler-stepping the
+        # gap with the last rates.
+        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 100)
         self.create_service(Empty, '~/reset', self._on_reset)
         self.create_service(SetPose2D, '~/set_pose', self._on_set_pose)
+
+    def _live_config(self, changes: dict[str, Any]) -> OdometryConfig:
+        try:
+            values = {name: tuple(value) for name, value in changes.items()}
+        except TypeError:
+            raise ValueError(f'{", ".join(changes)} must be lists of 6 numbers') from None
+        return dataclasses.replace(self._config, **values)
+
+    def _apply_config(self, config: OdometryConfig) -> None:
+        self._config = config
+        self._pose_covariance = _diagonal(config.pose_covariance_diagonal)
+        self._twist_covariance = _diagonal(config.twist_covariance_diagonal)
 
     def _make_tf_broadcaster(self):
         try:
@@ -125,18 +147,20 @@ class OdometryNode(Node):
 
     def _on_joint_states(self, msg: JointState) -> None:
         t = stamp_to_seconds(msg.header.stamp)
-        last_time = self._joint_odometry.last_time
-        if last_time is not None and t < last_time:
-            self.get_logger().info('time jumped back (sim reset?): restarting the integration, '
-                                   'pose kept')
         try:
-            due = self._joint_odometry.update(t, msg.name, msg.position, msg.velocity)
+            admission, due = self._gated.update(t, msg.name, msg.position, msg.velocity)
         except MissingJointError as error:
             self.get_logger().warn(f'{error}: odometry not updated', throttle_duration_sec=5.0)
             return
         except ValueError as error:
             self.get_logger().warn(f'odometry not updated: {error}', throttle_duration_sec=5.0)
             return
+        if admission.verdict is Verdict.REFUSE:
+            self.get_logger().warn(f'joint_states refused, odometry not updated: '
+                                   f'{admission.reason}', throttle_duration_sec=5.0)
+        elif admission.verdict is Verdict.RESTART:
+            self.get_logger().info(f'{admission.reason} (sim restarted?): restarting the '
+                                   'integration, pose kept', throttle_duration_sec=5.0)
         # Published on joint_states time, not a timer: in a lockstep sim every run publishes
         # the same poses, and a consumer can wait for the odom of a given state.
         if due:

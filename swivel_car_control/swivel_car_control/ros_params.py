@@ -1,9 +1,14 @@
-"""ROS glue shared by the nodes: config dataclasses as parameters, the main loop."""
+"""ROS glue shared by the nodes: config dataclasses as parameters, the main loop.
+
+Parameters the ROS 2 way: each is read-only (``ros2 param set`` prints "Trying to set a
+read-only parameter") unless its node applies it while running (``live_parameters``); a live
+one set to a bad value is refused with the reason.
+"""
 
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, Mapping, TypeVar
+from typing import Any, Callable, Collection, Mapping, TypeVar
 
 import rclpy
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
@@ -18,7 +23,8 @@ T = TypeVar('T')
 def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],
                       given: Mapping[str, Any] | None = None) -> T:
     """Declare one parameter per field of ``cls`` (but those ``given``, stated elsewhere)
-    and build it from their values.
+    and build it from their values; all read-only but the fields ``cls.LIVE`` names (if
+    it has that class attribute), which its node applies while running.
 
     Raises
     ------
@@ -26,6 +32,7 @@ def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],
         The dataclass refuses the values; the message names the field.
     """
     values = dict(given or {})
+    live = getattr(cls, 'LIVE', ())
     for field in dataclasses.fields(cls):
         if field.name in values:
             continue
@@ -35,15 +42,15 @@ def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],
         value = node.declare_parameter(
             field.name, list(default) if isinstance(default, tuple) else default,
             # Dynamic typing lets `kp:=19` (an integer) through; the dataclass validates.
-            ParameterDescriptor(description=descriptions[field.name],
-                                dynamic_typing=True)).value
+            ParameterDescriptor(description=descriptions[field.name], dynamic_typing=True,
+                                read_only=field.name not in live)).value
         values[field.name] = tuple(value) if isinstance(default, tuple) else value
     return cls(**values)
 
 
 def declare_description(node: Node) -> CarDescription:
-    """The robot description as parameters, the same names and defaults in every node
-    (``swivel_car_model.description``).
+    """The robot description as read-only parameters, the same names and defaults in every
+    node (``swivel_car_model.description``).
 
     Raises
     ------
@@ -52,7 +59,8 @@ def declare_description(node: Node) -> CarDescription:
     """
     return CarDescription.from_values({
         name: node.declare_parameter(
-            name, default, ParameterDescriptor(description=text, dynamic_typing=True)).value
+            name, default, ParameterDescriptor(description=text, dynamic_typing=True,
+                                               read_only=True)).value
         for name, (default, text) in description.PARAMETERS.items()})
 
 
@@ -70,8 +78,36 @@ def refuse_runtime_changes(node: Node, names: set[str]) -> None:
     node.add_on_set_parameters_callback(callback)
 
 
+def live_parameters(node: Node, names: Collection[str], check: Callable[[dict[str, Any]], T],
+                    apply: Callable[[T], None]) -> None:
+    """Parameters ``names`` apply while the node runs. ``check`` builds what a set of them
+    means (their new values by name) or raises ``ValueError``, which refuses the set with
+    its message as the reason; once set, ``apply`` takes what ``check`` built."""
+
+    def changes(parameters: list) -> dict[str, Any]:
+        return {p.name: p.value for p in parameters if p.name in names}
+
+    def validate(parameters: list) -> SetParametersResult:
+        try:
+            check(changes(parameters))
+        except ValueError as error:
+            return SetParametersResult(successful=False, reason=str(error))
+        return SetParametersResult(successful=True)
+
+    def commit(parameters: list) -> None:
+        changed = changes(parameters)
+        if changed:
+            apply(check(changed))
+            node.get_logger().info(
+                'set ' + ', '.join(f'{name} = {value!r}' for name, value in changed.items()))
+
+    node.add_on_set_parameters_callback(validate)
+    node.add_post_set_parameters_callback(commit)
+
+
 def run_node(node_class: type[Node], name: str, args: list[str] | None = None) -> int:
-    """The Jazzy main loop for one node; a refused parameter ends it with a clear error.
+    """The Jazzy main loop for one node; a refused parameter ends it with a clear error, a
+    signal (Ctrl-C, SIGTERM) quietly, also when it lands inside a callback.
 
     Returns the process exit code (0, or 1 for a configuration error).
     """
@@ -82,9 +118,14 @@ def run_node(node_class: type[Node], name: str, args: list[str] | None = None) -
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    except (ValueError, ParameterException) as error:
-        rclpy.logging.get_logger(name).fatal(f'bad configuration: {error}')
-        return 1
+    except Exception as error:
+        if not rclpy.ok():
+            pass  # SIGINT/SIGTERM shut the context under a callback: "context is invalid"
+        elif isinstance(error, (ValueError, ParameterException)):
+            rclpy.logging.get_logger(name).fatal(f'bad configuration: {error}')
+            return 1
+        else:
+            raise
     finally:
         if node is not None:
             node.destroy_node()

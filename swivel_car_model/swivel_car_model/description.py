@@ -26,7 +26,7 @@ and a 10 N m drive: the car turns and its odometry is as the thesis models it, a
 car climbs 6 cm. ``config/designs/climbing.yaml`` moves the weight forward (centre of mass at
 47 %) with a 20 N m drive (docs/climbing_design.md): the swivel lifts whichever axle is
 lighter, and once the front is on the step the rear axle climbs by traction, which wants
-weight on the front wheels; it climbs 7 cm (8 cm in 89 % of benchmark climbs), but on flat
+weight on the front wheels; it climbs 7 cm (8 cm in 91 % of benchmark climbs), but on flat
 ground its swivel lifts a rear wheel, so it does not steer as the thesis models.
 
 Swivel gains. Thesis Table 2 (kp 19 N m/rad, ki 11.45 N m/(rad s), kd 5.5 N m s/rad, the
@@ -90,6 +90,10 @@ class CarDescription:
     wheel_width: float = described(0.03, 'wheel tread width [m]')
     max_swivel_angle: float = described(math.pi / 2,
                                      'mechanical swivel joint limit, symmetric [rad]')
+    swivel_limit: float = described(
+        1.4, 'largest |swivel angle| commanded (controller set point, planner command), at '
+        'most max_swivel_angle; the controller lowers it further to keep the tip-over rule '
+        '[rad]')
     wheel_mass: float = described(0.5, 'mass of one wheel [kg]')
     body_mass: float = described(
         2.495619701085839, 'central body (batteries, motors, electronics) at the apex [kg]')
@@ -228,7 +232,7 @@ class CarDescription:
             mass=sum(part.mass for part in parts), inertia=inertia_about_y_axis(parts),
             kp=self.kp, ki=self.ki, kd=self.kd, wheel_width=self.wheel_width,
             wheel_mass=self.wheel_mass, max_swivel_angle=self.max_swivel_angle,
-            swivel_torque_limit=self.swivel_torque_limit)
+            swivel_limit=self.swivel_limit, swivel_torque_limit=self.swivel_torque_limit)
 
 
 PARAMETERS: dict[str, tuple[Any, str]] = {

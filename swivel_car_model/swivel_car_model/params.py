@@ -44,6 +44,10 @@ class SwivelCarParams:
         Mass of each wheel, part of ``mass``. # [kg]
     max_swivel_angle : float
         Mechanical limit of the swivel joint, symmetric. # [rad]
+    swivel_limit : float
+        Largest |swivel angle| the stack commands (controller set point, planner command),
+        at most ``max_swivel_angle``; the controller lowers it further if the tip-over rule
+        needs it. # [rad]
     swivel_torque_limit : float
         Peak torque of the swivel actuator. # [N m]
 
@@ -65,6 +69,7 @@ class SwivelCarParams:
     wheel_width: float = 0.03  # [m]
     wheel_mass: float = 0.5  # [kg]
     max_swivel_angle: float = math.pi / 2  # [rad]
+    swivel_limit: float = 1.4  # [rad]
     swivel_torque_limit: float = 30.0  # [N m]
 
     def __post_init__(self) -> None:
@@ -84,6 +89,9 @@ class SwivelCarParams:
         if not 0.0 < self.max_swivel_angle <= math.pi / 2:
             raise ValueError(
                 f'max_swivel_angle must be in (0, pi/2], got {self.max_swivel_angle!r}')
+        if not 0.0 < self.swivel_limit <= self.max_swivel_angle:
+            raise ValueError(f'swivel_limit must be in (0, max_swivel_angle '
+                             f'{self.max_swivel_angle!r}], got {self.swivel_limit!r}')
         if 4.0 * self.wheel_mass >= self.mass:
             raise ValueError(
                 f'wheel_mass must be below mass / 4, got {self.wheel_mass!r} of {self.mass!r}')

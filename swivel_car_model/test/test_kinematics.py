@@ -248,7 +248,7 @@ def test_bad_theta1_raises(func):
 
 
 def test_limited_joint_range_is_respected():
-    p = SwivelCarParams(max_swivel_angle=1.0)
+    p = SwivelCarParams(max_swivel_angle=1.0, swivel_limit=1.0)
     with pytest.raises(ValueError, match='theta2'):
         k.lift_angle(p, 1.01)
     with pytest.raises(ValueError, match='steering'):

@@ -12,7 +12,7 @@ busy-wait at full CPU while a climb ran.)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 from nav_msgs.msg import Odometry
 import rclpy
@@ -24,7 +24,7 @@ from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.task import Future
-from rcl_interfaces.msg import ParameterDescriptor
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from sensor_msgs.msg import Imu, JointState
 from swivel_car_model import kinematics
 from swivel_car_model import description
@@ -74,28 +74,34 @@ class PlannerNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('planner', **kwargs)
+        # The climb's settings apply from the next climb on; the rest is read-only. All
+        # dynamically typed, so that an integer where a number is due passes; the configs
+        # check the types.
         self.config = PlannerConfig(**{
-            item.name: float(self.declare_parameter(
-                item.name, item.default,
-                ParameterDescriptor(description=item.metadata['description'])).value)
+            item.name: self.declare_parameter(
+                item.name, item.default, ParameterDescriptor(
+                    description=item.metadata['description'], dynamic_typing=True)).value
             for item in fields(PlannerConfig)})
+        self.add_on_set_parameters_callback(self._check_config)
+        self.add_post_set_parameters_callback(self._apply_config)
         self.description = CarDescription.from_values({
             name: self.declare_parameter(
-                name, default, ParameterDescriptor(description=text,
-                                                   dynamic_typing=True)).value
+                name, default, ParameterDescriptor(description=text, dynamic_typing=True,
+                                                   read_only=True)).value
             for name, (default, text) in description.PARAMETERS.items()})
         self.robot = self.description.model_params()
         self.whole_car_limit = self._load_capability(self.declare_parameter(
             'capability_file', capability.INSTALLED, ParameterDescriptor(
                 description="the measured whole-car capability table (YAML); 'installed': "
                             "the package's config/capability.yaml; 'none': no table, only "
-                            "the model's limits")).value)
+                            "the model's limits", read_only=True)).value)
         self._ready_timeout = self._positive_parameter(
             'ready_timeout', 1.0, 'inputs older than this (sim time) mean not ready; a climb '
                                   'whose inputs stop for this long aborts [s]')
         self._swivel_joint = self.declare_parameter(
             'swivel_joint', 'swivel_joint',
-            ParameterDescriptor(description='name of the swivel joint in joint_states')).value
+            ParameterDescriptor(description='name of the swivel joint in joint_states',
+                                read_only=True)).value
 
         self._climb: _ActiveClimb | None = None
         self._received: dict[str, float] = {}  # topic -> sim time of its last message [s]
@@ -123,11 +129,30 @@ class PlannerNode(Node):
             f'{self.robot.swivel_torque_limit:.1f} N m')
 
     def _positive_parameter(self, name: str, default: float, description: str) -> float:
-        value = float(self.declare_parameter(
-            name, default, ParameterDescriptor(description=description)).value)
-        if not math.isfinite(value) or value <= 0.0:
+        value = self.declare_parameter(name, default, ParameterDescriptor(
+            description=description, dynamic_typing=True, read_only=True)).value
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not math.isfinite(value) or value <= 0.0:
             raise ValueError(f'parameter {name} must be finite and > 0, got {value!r}')
         return value
+
+    def _changed_config(self, parameters: list) -> PlannerConfig:
+        """The climb settings with ``parameters`` set. Raises ValueError naming a bad one."""
+        names = {item.name for item in fields(PlannerConfig)}
+        return replace(self.config, **{p.name: p.value for p in parameters if p.name in names})
+
+    def _check_config(self, parameters: list) -> SetParametersResult:
+        try:
+            self._changed_config(parameters)
+        except ValueError as error:
+            return SetParametersResult(successful=False, reason=str(error))
+        return SetParametersResult(successful=True)
+
+    def _apply_config(self, parameters: list) -> None:
+        config = self._changed_config(parameters)
+        if config != self.config:
+            self.config = config
+            self.get_logger().info('climb settings changed: they apply from the next climb')
 
     def _load_capability(self, value: str) -> float:
         """The highest step the whole car climbs reliably, from the table ``value`` names
@@ -344,9 +369,14 @@ def main(args=None) -> None:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    except (ValueError, ParameterException) as error:
-        rclpy.logging.get_logger('planner').fatal(f'bad configuration: {error}')
-        code = 1
+    except Exception as error:
+        if not rclpy.ok():
+            pass  # SIGINT/SIGTERM shut the context under a callback: "context is invalid"
+        elif isinstance(error, (ValueError, ParameterException)):
+            rclpy.logging.get_logger('planner').fatal(f'bad configuration: {error}')
+            code = 1
+        else:
+            raise
     finally:
         if node is not None:
             node.destroy_node()

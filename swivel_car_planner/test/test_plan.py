@@ -4,8 +4,9 @@ import dataclasses
 import math
 
 from hypothesis import given, settings, strategies as st
+import numpy as np
 import pytest
-from swivel_car_model import climbing, dynamics, kinematics
+from swivel_car_model import climbing, dynamics, kinematics, planar
 from swivel_car_model.params import SwivelCarParams
 
 from swivel_car_planner.core import (
@@ -99,11 +100,61 @@ def test_plan_only_makes_exactly_the_checks_of_a_real_call():
 def test_approach_accounts_for_the_drift_of_the_lift():
     plan = make_plan(P, FRONT, request(0.15))
     _, _, drift_yaw = dynamics.swivel_pose_drift(P, 0.0, plan.swivel_angle)
-    assert plan.approach_heading == pytest.approx(plan.lead_angle - drift_yaw)
+    assert plan.approach_heading == pytest.approx(
+        plan.lead_angle - plan.advance_turn - drift_yaw)
     assert plan.lead_distance >= P.r + CONFIG.lift_gap
     axle_normal = plan.approach_distance * math.cos(plan.approach_heading)
     assert axle_normal == pytest.approx(
         plan.lead_distance + P.h * abs(math.sin(plan.approach_heading)))
+
+
+def drive_arc(plan, steps=2000):
+    """Euler-integrate base_link along the plan's advance from its heading once the wheel is
+    up, at the model's curvature; the front wheels' rest points' normal coordinates, relative
+    to the start, along the way. # [m]"""
+    curvature = planar.curvature_for_swivel(P, plan.swivel_angle)
+    heading = plan.lead_angle - plan.advance_turn
+    ds = plan.advance_length / steps
+    x, lifted, other = 0.0, [], []
+    for _ in range(steps + 1):
+        for side, out in ((plan.lifted_side, lifted), (-plan.lifted_side, other)):
+            out.append(x + P.wheelbase * math.cos(heading) - side * P.h * math.sin(heading))
+        x += ds * math.cos(heading + curvature * ds / 2.0)
+        heading += curvature * ds
+    return heading - curvature * ds, np.array(lifted), np.array(other)
+
+
+@pytest.mark.parametrize('height', [0.05, 0.15, 0.25, 0.26])
+def test_the_advance_arc_takes_the_lifted_wheel_over_the_edge_clear_of_the_other(height):
+    plan = make_plan(P, FRONT, request(height))
+    end_heading, lifted, other = drive_arc(plan)
+    assert end_heading == pytest.approx(plan.lead_angle, abs=1e-6)
+    start = -plan.lead_distance  # [m] the lifted wheel's contact to the edge at lift
+    assert lifted[-1] - lifted[0] == pytest.approx(plan.lead_distance + CONFIG.lead_margin,
+                                                   abs=1e-4)
+    reach = min(height, P.r)  # [m] a wheel meets an edge at least r high at r from it
+    other_edge = other - other[0] + start + 2.0 * plan.lifted_side * P.h * math.sin(
+        plan.lead_angle - plan.advance_turn)
+    assert np.max(other_edge) <= -(reach + CONFIG.lead_margin) + 1e-3
+
+
+def test_a_tight_advance_arc_is_planned_as_one():
+    """At 26 cm the swivel is held at 1.24 rad: a 0.49 m radius, and the lift alone turns the
+    car 0.37 rad. The arc ends more oblique than the straight-line lead angle (the other
+    wheel swings towards the riser on the way) and the approach leads with the other wheel.
+    At 27 cm (1.37 rad, 0.28 m) no heading keeps the other wheel off the riser."""
+    plan = make_plan(P, FRONT, request(0.26))
+    assert abs(plan.swivel_angle) <= P.swivel_limit
+    assert abs(plan.lead_angle) > lead_angle(P, CONFIG, 0.26) + 0.1
+    assert abs(plan.advance_turn) > 0.3
+    assert plan.lifted_side * plan.approach_heading > 0.0
+    error = refusal(height=0.27)
+    assert error.code == ErrorCode.WHEEL_INTERFERENCE and 'riser' in error.message
+
+
+def test_a_step_beyond_the_swivel_limit_is_refused_with_it():
+    error = refusal(p=dataclasses.replace(P, swivel_limit=1.2), height=0.26)
+    assert error.code == ErrorCode.UNREACHABLE_HEIGHT and 'swivel_limit' in error.message
 
 
 def test_step_beyond_reach_is_unreachable():
@@ -141,7 +192,7 @@ def test_step_too_close_to_align_is_invalid_without_room_to_back_up():
     assert error.code == ErrorCode.INVALID_REQUEST
     assert 'too close' in error.message
     error = refusal(config=dataclasses.replace(FRONT, max_backup=0.2), height=0.05,
-                    distance=0.1, yaw=0.3)
+                    distance=0.1, yaw=0.5)
     assert 'too close' in error.message and 'max_backup' in error.message
 
 

@@ -36,8 +36,11 @@ class SimNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('sim', **kwargs)
+        # Read-only: the world is built from them at start. Dynamically typed so that an
+        # integer where a number is due (mass:=21) passes; SimNodeConfig checks the types.
         for name, (default, description) in PARAMETERS.items():
-            self.declare_parameter(name, default, ParameterDescriptor(description=description))
+            self.declare_parameter(name, default, ParameterDescriptor(
+                description=description, dynamic_typing=True, read_only=True))
         try:
             self.config = SimNodeConfig.from_values(
                 {name: self.get_parameter(name).value for name in PARAMETERS})
@@ -237,9 +240,14 @@ def main(args=None) -> None:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    except (ValueError, ParameterException) as error:
-        rclpy.logging.get_logger('sim').fatal(str(error))
-        raise SystemExit(1) from None
+    except Exception as error:
+        if not rclpy.ok():
+            pass  # SIGINT/SIGTERM shut the context under a callback: "context is invalid"
+        elif isinstance(error, (ValueError, ParameterException)):
+            rclpy.logging.get_logger('sim').fatal(str(error))
+            raise SystemExit(1) from None
+        else:
+            raise
     finally:
         if node is not None:
             node.destroy_node()

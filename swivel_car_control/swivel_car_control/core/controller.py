@@ -8,7 +8,8 @@ raise ``ValueError`` (changing nothing) for commands they refuse.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
+from typing import ClassVar
 
 from swivel_car_model.params import SwivelCarParams
 
@@ -35,9 +36,6 @@ class ControllerConfig:
         Clamp on the PID's integral contribution. # [N m]
     integral_band : float
         The PID integrates only while |set point - measured| is below this. # [rad]
-    swivel_limit : float
-        Largest |swivel set point|, <= the joint's mechanical limit; reduced further if the
-        tip-over rule needs it. # [rad]
     max_swivel_rate : float
         Set-point rate limit. # [rad/s]
     max_linear_velocity, max_linear_acceleration : float
@@ -61,7 +59,6 @@ class ControllerConfig:
     max_torque: float = 30.0  # [N m]
     max_integral_torque: float = 15.0  # [N m]
     integral_band: float = 0.05  # [rad]
-    swivel_limit: float = 1.4  # [rad]
     max_swivel_rate: float = 1.5  # [rad/s]
     max_linear_velocity: float = 0.5  # [m/s]
     max_linear_acceleration: float = 1.0  # [m/s^2]
@@ -72,13 +69,17 @@ class ControllerConfig:
     slowdown_start: float = 0.15  # [rad]
     slowdown_stop: float = 0.6  # [rad]
     tip_over_margin: float = 0.1  # [rad]
+    # The fields ``SwivelController.step`` reads afresh every period: they may change while
+    # it runs (``reconfigure``).
+    LIVE: ClassVar[tuple[str, ...]] = ('cmd_vel_timeout', 'swivel_command_timeout',
+                                       'slowdown_start', 'slowdown_stop')
 
     def __post_init__(self) -> None:
         for field in fields(self):
             value = getattr(self, field.name)
             if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0.0:
                 raise ValueError(f'{field.name} must be a finite number >= 0, got {value!r}')
-        for name in ('max_torque', 'integral_band', 'swivel_limit', 'max_swivel_rate',
+        for name in ('max_torque', 'integral_band', 'max_swivel_rate',
                      'max_linear_velocity',
                      'max_linear_acceleration', 'max_angular_velocity',
                      'max_angular_acceleration'):
@@ -123,22 +124,19 @@ class SwivelController:
     Parameters
     ----------
     p : SwivelCarParams
-        Geometry and the PID gains ``kp, ki, kd``.
+        Geometry, the PID gains ``kp, ki, kd`` and the ``swivel_limit``.
     config : ControllerConfig
 
     Raises
     ------
     ValueError
-        ``config.swivel_limit`` beyond the joint limit, or the tip-over rule unsatisfiable.
+        The tip-over rule unsatisfiable.
     """
 
     def __init__(self, p: SwivelCarParams, config: ControllerConfig) -> None:
         self.p = p
         self.config = config
-        if config.swivel_limit > p.max_swivel_angle:
-            raise ValueError(f'swivel_limit {config.swivel_limit!r} rad exceeds the joint '
-                             f'limit max_swivel_angle {p.max_swivel_angle!r} rad')
-        self.swivel_limit = tip_safe_swivel_limit(p, config.swivel_limit,
+        self.swivel_limit = tip_safe_swivel_limit(p, p.swivel_limit,
                                                   config.tip_over_margin)  # [rad]
         self.steering = SteeringMap(p, self.swivel_limit, config.max_linear_velocity)
         self.pid = SwivelPid(PidConfig(p.kp, p.ki, p.kd, config.max_torque,
@@ -157,6 +155,21 @@ class SwivelController:
     def swivel_command(self) -> SwivelCommandRequest | None:
         """The planner's command being held, if any."""
         return self._swivel_command
+
+    def reconfigure(self, config: ControllerConfig) -> None:
+        """Go on with ``config``, which may differ from the current one only in
+        ``ControllerConfig.LIVE``.
+
+        Raises
+        ------
+        ValueError
+            Another field differs; nothing changes.
+        """
+        fixed = [f.name for f in fields(config) if f.name not in config.LIVE
+                 and getattr(config, f.name) != getattr(self.config, f.name)]
+        if fixed:
+            raise ValueError(f'{", ".join(fixed)} cannot change while the controller runs')
+        self.config = config
 
     def set_cmd_vel(self, v: float, omega: float, stamp: float) -> None:
         """Take a velocity command: v [m/s], omega [rad/s], stamp [s] (its time).
@@ -194,7 +207,7 @@ class SwivelController:
                 raise ValueError(f'swivel_command {name} is {value!r}: refused')
         if max_rate < 0.0:
             raise ValueError(f'swivel_command max_rate must be >= 0, got {max_rate!r}: refused')
-        limit = self.config.swivel_limit
+        limit = self.p.swivel_limit
         if abs(angle) > limit:
             raise ValueError(f'swivel_command angle {angle!r} rad is outside +-{limit!r} rad: '
                              'refused')
@@ -211,16 +224,29 @@ class SwivelController:
 
     def step(self, t: float, measured: float, measured_rate: float) -> ControlOutput:
         """One control period at time ``t`` [s] with the measured swivel angle [rad] and rate
-        [rad/s]. Time going backwards (a sim reset) restarts the controller's memory."""
+        [rad/s]. Time going backwards (a sim reset) restarts the controller's memory and drops
+        the commands given before: they belong to the old run.
+
+        The deadmans count in the time of these steps, whatever clock stamped a command: a
+        command stamped later than ``t`` (another clock, a /clock far ahead, a runtime
+        ``use_sim_time`` change) counts as given at ``t``, so no stamp keeps it alive
+        longer than its timeout of steps.
+        """
         for name, value in (('t', t), ('measured', measured), ('measured_rate', measured_rate)):
             if not math.isfinite(value):
                 raise ValueError(f'{name} must be finite, got {value!r}')
         if self._last_time is None or t < self._last_time:
+            if self._last_time is not None:
+                self._cmd_vel = self._swivel_command = None
             self._restart(measured)
             dt = 0.0
         else:
             dt = t - self._last_time
         self._last_time = t
+        if self._cmd_vel is not None and self._cmd_vel[2] > t:
+            self._cmd_vel = (*self._cmd_vel[:2], t)
+        if self._swivel_command is not None and self._swivel_command.stamp > t:
+            self._swivel_command = replace(self._swivel_command, stamp=t)
         timed_out = False
         max_rate = None
         command = self._swivel_command

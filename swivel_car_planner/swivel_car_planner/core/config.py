@@ -70,7 +70,6 @@ class PlannerConfig:
     bias_gain: float = described(
         2.0, 'outer loop: command bias per remaining swivel error and second [1/s]')
     max_bias: float = described(0.6, 'outer loop: largest command bias [rad]')
-    max_swivel_command: float = described(1.2, 'largest |swivel command| sent [rad]')
     stall_progress: float = described(
         0.01, 'the swivel must close on its goal by this much every stall_time [rad]')
     stall_time: float = described(4.0, 'swivel making no headway this long: stall [s]')
@@ -94,7 +93,7 @@ class PlannerConfig:
                 raise ValueError(f'{item.name} must be >= 0, got {value!r}')
         for name in ('max_step_distance', 'max_step_yaw', 'max_lead_angle',
                      'approach_speed', 'climb_speed', 'rear_speed', 'swivel_rate', 'max_steer',
-                     'max_swivel_command', 'swivel_tolerance', 'settle_rate', 'stop_speed',
+                     'swivel_tolerance', 'settle_rate', 'stop_speed',
                      'stall_progress',
                      'stall_time', 'slip_yaw_tolerance', 'no_progress_time', 'min_progress',
                      'time_allowance'):

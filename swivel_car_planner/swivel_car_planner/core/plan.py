@@ -25,10 +25,25 @@ the model's minimum approach angle (``climbing.min_approach_angle_for_step``, th
 92-100 with exact wheel discs), the bound the thesis derives for phi < 0; for phi > 0 the
 derivation above is the larger one.
 
+Advancing with the wheel up is no straight line: the swivel is held at the lift angle, so
+base_link follows an arc of the model's curvature at that angle (``planar``; a 0.28 m radius
+at 1.37 rad, the lift of a 27 cm step), turning away from the lifted side. The plan puts the
+*end* of that arc at ``psi_lead`` (the lifted wheel ``lead_margin`` past the edge, the other
+``a + lead_margin`` short of it) and starts it ``advance_turn`` earlier. The lift's yaw and
+the arc's turn both point the car away from the lifted side, so the approach must start
+turned towards it: on a tight arc the other wheel then leads at the lift and swings towards
+the riser on the way, and the end heading is made more oblique until that wheel stays off the
+riser (its contact at least ``a`` short) throughout. Up to 26 cm such a heading exists; at
+27 cm (1.37 rad: the lift yaws 0.41 rad, the arc is 0.28 m) none does below
+``max_lead_angle``, and the plan refuses it. Drawn as a straight line, the lifted wheel of a
+27 cm climb swung along the edge instead of over it: a wheel at the lifted side's corner
+moves at 45 degrees to the car's heading on that arc, and the car circled in front of the
+step.
+
 Lifting the wheel turns and shifts the car (thesis II.E; ``dynamics.swivel_pose_drift``): the
-approach aims at ``psi_lead - drift_yaw`` so that the car meets the edge at ``psi_lead``
-once the wheel is up, and starts the lift far enough back that the drift does not push the
-rising wheel into the riser.
+approach aims at ``psi_lead - advance_turn - drift_yaw`` so that the car starts the arc at the
+planned heading once the wheel is up, and starts the lift far enough back that the drift does
+not push the rising wheel into the riser.
 """
 
 from __future__ import annotations
@@ -37,7 +52,10 @@ import dataclasses
 from dataclasses import dataclass
 import math
 
-from swivel_car_model import climbing, dynamics, kinematics
+import numpy as np
+from scipy.optimize import brentq
+
+from swivel_car_model import climbing, dynamics, kinematics, planar
 from swivel_car_model.params import SwivelCarParams
 
 from swivel_car_planner.core.codes import ErrorCode
@@ -77,7 +95,7 @@ class ClimbPlan:
     interference_margin: float  # [m]
     duration: float  # [s] predicted
     lifted_side: int  # +1: left front wheel lifted (theta2 > 0), -1: right
-    lead_angle: float  # [rad] heading to the normal, signed, once the wheel is up
+    lead_angle: float  # [rad] heading to the normal, signed, once the wheel is over the edge
     lead_distance: float  # [m] lifted wheel's contact to the edge (along the normal) at lift
     second_swivel_angle: float  # [rad] swivel that holds the second wheel clearance_margin up
     step_height: float  # [m]
@@ -87,6 +105,10 @@ class ClimbPlan:
     crossing: float | None = None
     # [m] the car first backs up this far, straight, to make room for the approach
     backup_distance: float = 0.0
+    # [rad] heading change while the lifted wheel advances over the edge (the arc; module
+    # docstring); ``lead_angle - advance_turn`` is the heading once the wheel is up
+    advance_turn: float = 0.0
+    advance_length: float = 0.0  # [m] base_link's path along that arc
 
 
 def lead_angle(p: SwivelCarParams, config: PlannerConfig, step_height: float) -> float:
@@ -128,11 +150,83 @@ def crossing_range(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequ
 
 
 @dataclass(frozen=True)
+class AdvanceArc:
+    """The lifted wheel's advance over the edge, base_link on an arc (module docstring)."""
+
+    end_heading: float  # [rad] heading to the edge's normal when the wheel is over the edge
+    turn: float  # [rad] signed heading change along the arc
+    length: float  # [m] base_link's path
+
+
+_ARC_SAMPLES = 400
+
+
+def advance_arc(p: SwivelCarParams, config: PlannerConfig, swivel: float, side: int,
+                lead: float, lead_distance: float, reach: float,
+                drift_yaw: float) -> AdvanceArc:
+    """The arc of ADVANCE with the swivel held at ``swivel``: the lifted wheel (rest
+    geometry, as the state machine measures it) moves from ``lead_distance`` short of the
+    edge to ``lead_margin`` past it and ends at a heading at least ``lead`` oblique (signed
+    ``-side``), while the other front wheel stays off the riser (its contact at least
+    ``reach`` short of the edge) when the lift starts (the heading then ``drift_yaw`` before
+    the arc's start), once the wheel is up, and along the arc; at the end of the arc it is
+    ``reach + lead_margin`` short or more, by the lead angle. # [rad], [m]
+
+    Raises
+    ------
+    PlanError
+        ``WHEEL_INTERFERENCE``: no end heading up to ``max_lead_angle`` keeps the other
+        wheel off the riser.
+    """
+    curvature = float(planar.curvature_for_swivel(p, swivel))  # [1/m]
+    bx, by = p.wheelbase, side * p.h
+    travel = lead_distance + config.lead_margin  # [m]
+
+    def normal_shift(end: float, length: float | np.ndarray, y: float) -> np.ndarray:
+        """Normal displacement of the base_link point (bx, y) over the last ``length`` of
+        the arc ending at ``end``; sinc keeps the straight limit exact. # [m]"""
+        start = end - curvature * length
+        half = curvature * np.asarray(length) / 2.0
+        base = length * np.cos(end - half) * np.sinc(half / np.pi)
+        return base + bx * (np.cos(end) - np.cos(start)) - y * (np.sin(end) - np.sin(start))
+
+    # Base_link cannot turn more than half a circle before the wheel is over; cap the search
+    # at a few metres for the straight case.
+    longest = min(4.0, math.pi / abs(curvature)) if curvature != 0.0 else 4.0  # [m]
+    lengths = np.linspace(0.0, longest, _ARC_SAMPLES)
+    for end in np.linspace(lead, config.max_lead_angle, 40):
+        end = -side * float(end)
+        shifts = normal_shift(end, lengths, by)
+        beyond = np.nonzero(shifts >= travel)[0]
+        if beyond.size == 0:
+            continue
+        k = int(beyond[0])
+        length = float(brentq(lambda s: normal_shift(end, s, by) - travel,
+                              lengths[k - 1], lengths[k]))
+        # The other wheel's signed distance past the edge, over the whole arc.
+        along = np.linspace(0.0, length, _ARC_SAMPLES)
+        other_end = config.lead_margin + 2.0 * side * p.h * math.sin(end)  # [m]
+        other = other_end - normal_shift(end, along, -by)
+        start = end - curvature * length
+        at_lift = [-lead_distance + 2.0 * side * p.h * math.sin(heading)
+                   for heading in (start, start - drift_yaw)]
+        if max(np.max(other), *at_lift) <= -reach + 1e-9:
+            return AdvanceArc(end, curvature * length, length)
+    radius = 1.0 / abs(curvature) if curvature != 0.0 else math.inf  # [m]
+    raise PlanError(ErrorCode.WHEEL_INTERFERENCE,
+                    f'with the swivel held at {swivel:.2f} rad the lift turns the car by '
+                    f'{abs(drift_yaw):.2f} rad and the advance on a {radius:.2f} m radius: at no heading up to '
+                    f'{config.max_lead_angle:.2f} rad to the edge\'s normal does the lifted '
+                    f'wheel get over the edge with the other front wheel clear of the riser')
+
+
+@dataclass(frozen=True)
 class _Approach:
     """How the car meets the edge when it lifts the wheel on ``side``."""
 
     side: int  # +1: left front wheel lifted
-    lead: float  # [rad] heading to the normal once the wheel is up
+    lead: float  # [rad] heading to the normal once the wheel is over the edge
+    arc: AdvanceArc
     heading: float  # [rad] heading to the normal when the lift starts
     lead_distance: float  # [m] lifted wheel's contact to the edge at lift
     axle_normal: float  # [m] front axle centre to the edge at lift, along the normal
@@ -146,13 +240,22 @@ def _approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
     height = request.step_height
     # Never below the model's minimum approach angle (thesis eqs. 92-100, exact wheel discs;
     # the bound the thesis derives for phi < 0, and a check of the derivation above).
-    psi_lead = -side * max(lead_angle(p, config, height),
-                           float(climbing.min_approach_angle_for_step(p, height)))
+    lead = max(lead_angle(p, config, height),
+               float(climbing.min_approach_angle_for_step(p, height)))
+    swivel = side * abs(theta2)
     drift_x, drift_y, drift_yaw = (
-        float(v) for v in dynamics.swivel_pose_drift(p, 0.0, side * abs(theta2)))
-    heading = psi_lead - drift_yaw
-    drift_normal = drift_x * math.cos(heading) - drift_y * math.sin(heading)
-    lead_distance = p.r + config.lift_gap + max(0.0, drift_normal)
+        float(v) for v in dynamics.swivel_pose_drift(p, 0.0, swivel))
+    reach = math.sqrt(p.r ** 2 - (p.r - min(height, p.r)) ** 2)  # [m] see lead_angle
+    # The drift's push towards the riser lengthens the advance, which turns the heading at
+    # lift: twice round settles it (the drift is a few millimetres).
+    lead_distance = p.r + config.lift_gap
+    for _ in range(2):
+        advance = advance_arc(p, config, swivel, side, lead, lead_distance, reach,
+                              drift_yaw)
+        heading = advance.end_heading - advance.turn - drift_yaw
+        drift_normal = drift_x * math.cos(heading) - drift_y * math.sin(heading)
+        lead_distance = p.r + config.lift_gap + max(0.0, drift_normal)
+    psi_lead = advance.end_heading
     axle_normal = lead_distance + p.h * abs(math.sin(heading))
 
     # Aligning turns on an arc of radius >= wheelbase / tan(max_steer); give it room.
@@ -196,7 +299,7 @@ def _approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
             error = (f'the step is too close: the car would cross the edge {shift:.2f} m '
                      f'beside the top face; the approach can move its crossing by '
                      f'{room:.2f} m')
-    return _Approach(side, psi_lead, heading, lead_distance, axle_normal, crossing, shift,
+    return _Approach(side, psi_lead, advance, heading, lead_distance, axle_normal, crossing, shift,
                      error)
 
 
@@ -229,6 +332,13 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
                         f'a {height:.3f} m step plus {config.clearance_margin:.3f} m clearance '
                         f'is beyond the lifted wheel\'s reach ({reach:.3f} m): {error}') \
             from error
+    if abs(theta2) > p.swivel_limit:
+        limit_height = float(kinematics.lifted_wheel_lowest_height(p, p.swivel_limit))
+        raise PlanError(ErrorCode.UNREACHABLE_HEIGHT,
+                        f'a {height:.3f} m step plus {config.clearance_margin:.3f} m clearance '
+                        f'needs the swivel at {abs(theta2):.3f} rad, beyond the robot\'s '
+                        f'swivel_limit of {p.swivel_limit:.3f} rad (which lifts the wheel '
+                        f'{limit_height:.3f} m)')
     if height > whole_car_limit:
         raise PlanError(ErrorCode.UNREACHABLE_HEIGHT,
                         f'the front wheels could lift over {height:.3f} m, but the whole car '
@@ -288,7 +398,7 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
     cos_lead = math.cos(psi_lead)
     duration = ((backup + max(0.0, available - axle_normal) / max(0.5, cos_lead)) / v_approach
                 + 2.0 * abs(theta2) / config.swivel_rate + config.settle_time
-                + (lead_distance + config.lead_margin) / cos_lead / v_climb
+                + approach.arc.length / v_climb
                 + (p.wheelbase + 2.0 * p.h * abs(math.sin(psi_lead)) + config.rest_margin)
                 / cos_lead / v_climb)
     return ClimbPlan(
@@ -301,7 +411,8 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
         lifted_side=side, lead_angle=psi_lead, lead_distance=lead_distance,
         second_swivel_angle=-side * float(kinematics.swivel_for_step(
             p, config.clearance_margin, respect_tip_over=False)),
-        step_height=height, crossing=approach.crossing, backup_distance=backup)
+        step_height=height, crossing=approach.crossing, backup_distance=backup,
+        advance_turn=approach.arc.turn, advance_length=approach.arc.length)
 
 
 _BACKUP_INCREMENT = 0.05  # [m]

@@ -379,7 +379,7 @@ class ClimbStateMachine:
             self._bias = min(config.max_bias, max(
                 -config.max_bias, self._bias + config.bias_gain * error * dt))
         self._goal_error = abs(error)
-        limit = config.max_swivel_command
+        limit = self._p.swivel_limit
         self._last_command = min(limit, max(-limit, angle + self._bias))
         return Command(self._last_command, config.swivel_rate, drive_speed, True)
 
