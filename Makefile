@@ -19,6 +19,8 @@ $(STAMP): requirements.txt
 
 build: setup
 	@echo '== building ros2_ws'
+	@# A file removed from a package leaves a dangling symlink that fails the symlink install.
+	-find ros2_ws/build ros2_ws/install -xtype l -delete 2>/dev/null
 	cd ros2_ws && ../$(IN_WS) colcon build --symlink-install --event-handlers console_cohesion- summary+ \
 	    --cmake-args -DBUILD_TESTING=OFF
 

@@ -1,4 +1,4 @@
-"""The climbing benchmark's own arithmetic, and the shipped table of the climbing design."""
+"""The climbing benchmark's own arithmetic, and the shipped tables of the designs."""
 
 from pathlib import Path
 
@@ -22,15 +22,18 @@ def test_heights_are_whole_increments_from_start_to_stop():
     assert heights(0.02, 0.05, 0.01) == [0.02, 0.03, 0.04, 0.05]
 
 
-def test_the_climbing_design_ships_with_a_table_measured_on_it():
-    model = Path(get_package_share_directory('swivel_car_model'))
-    description = CarDescription().replace(
-        **design_values(model / 'config' / 'designs' / 'climbing.yaml'))
+def test_each_shipped_design_has_a_table_measured_on_it():
     planner = Path(get_package_share_directory('swivel_car_planner'))
-    table = CapabilityTable.load(planner / 'config' / 'capability_climbing.yaml')
-    assert table.matches(description)
+    default = CapabilityTable.load(planner / 'config' / 'capability.yaml')
+    assert default.matches(CarDescription())
+    assert default.limit >= 0.07
+    model = Path(get_package_share_directory('swivel_car_model'))
+    thesis_inertia = CarDescription().replace(
+        **design_values(model / 'config' / 'designs' / 'thesis_inertia.yaml'))
+    table = CapabilityTable.load(planner / 'config' / 'capability_thesis_inertia.yaml')
+    assert table.matches(thesis_inertia)
     assert not table.matches(CarDescription())
-    assert table.limit >= 0.07
+    assert table.limit == pytest.approx(0.06)
 
 
 @pytest.mark.parametrize('option, message', [

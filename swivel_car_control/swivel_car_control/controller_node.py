@@ -27,7 +27,8 @@ _CLOCK_SLACK = 0.5  # [s]
 
 CONFIG_DESCRIPTIONS = {
     'max_integral_torque': 'clamp on the PID integral contribution [N m]',
-    'integral_band': 'the PID integrates only while |error| is below this [rad]',
+    'integral_band': 'while the set point ramps, the PID integrates only while |error| is '
+                     'below this [rad]',
     'max_swivel_rate': 'swivel set-point rate limit [rad/s]',
     'max_linear_velocity': 'forward speed limit of base_link [m/s]',
     'max_linear_acceleration': 'forward acceleration limit [m/s^2]',

@@ -86,11 +86,13 @@ def test_rejects_bad_input_and_config():
         PidConfig(kp=1.0, ki=math.nan, kd=0.0, max_torque=1.0, max_integral_torque=0.0)
 
 
-def test_integral_band_stops_integration_on_large_errors():
+def test_integral_band_stops_integration_on_large_errors_while_the_set_point_moves():
     pid = SwivelPid(PidConfig(kp=1.0, ki=10.0, kd=0.0, max_torque=100.0,
                               max_integral_torque=100.0, integral_band=0.05))
-    assert pid.step(0.5, 0.0, 0.0, 0.1).i_term == 0.0
-    assert pid.step(0.04, 0.0, 0.0, 0.1).i_term == pytest.approx(0.04)
+    assert pid.step(0.5, 0.0, 0.0, 0.1, set_point_moving=True).i_term == 0.0
+    assert pid.step(0.04, 0.0, 0.0, 0.1, set_point_moving=True).i_term == pytest.approx(0.04)
+    # Resting, a load that holds the swivel outside the band is integrated away.
+    assert pid.step(0.5, 0.0, 0.0, 0.1).i_term == pytest.approx(0.54)
     with pytest.raises(ValueError, match='integral_band'):
         PidConfig(kp=1.0, ki=0.0, kd=0.0, max_torque=1.0, max_integral_torque=0.0,
                   integral_band=0.0)

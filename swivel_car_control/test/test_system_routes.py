@@ -33,11 +33,12 @@ from swivel_car_control.test.test_system import _seconds, _yaw
 
 SETTLE = 1.0  # [s] sim time standing still at the end of a route, as the benchmark
 # Our odometry's end-pose error, % of the distance travelled; the in-process benchmark
-# measures 0.003-1.18 % on these routes (the misses over 1 % are rear-wheel slip in tight turns).
+# measures 0.04-0.69 % on these routes (wheel slip in tight turns).
 MAX_ERROR_PERCENT = 2.0
-# [m] The sweep at standstill moves base_link 8.7 cm (the swivel's reaction), too little to
-# divide by: typically 0.4 mm; one run in about ten gave 6 mm (unexplained, see the notes).
-MAX_STANDSTILL_ERROR = 0.01
+# [m] The sweep at standstill moves base_link 11 cm, too little to divide by. With the weight
+# forward the front wheels grip and the rear axle skids sideways as the swivel turns: wheel
+# encoders cannot see it, and the benchmark measures 4.8 cm of error.
+MAX_STANDSTILL_ERROR = 0.06
 
 
 class RouteDriver:

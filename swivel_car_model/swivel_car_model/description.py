@@ -20,14 +20,16 @@ x forward, y left, z up)::
     front_t:   front column (rod from the apex to the front axle), front axle housing
     wheels:    four solid discs at (0, +-h, 0) and (wheelbase, +-h, 0)
 
-Mass layout and drive train. The defaults match the thesis' I_s = 0.84 kg m^2 with the heavy
-parts in the rear axle housing (centre of mass at 24 % of the wheelbase), open differentials
-and a 10 N m drive: the car turns and its odometry is as the thesis models it, and the whole
-car climbs 6 cm. ``config/designs/climbing.yaml`` moves the weight forward (centre of mass at
-47 %) with a 20 N m drive (docs/climbing_design.md): the swivel lifts whichever axle is
+Mass layout and drive train (docs/climbing_design.md). The swivel lifts whichever axle is
 lighter, and once the front is on the step the rear axle climbs by traction, which wants
-weight on the front wheels; it climbs 7 cm (8 cm in 91 % of benchmark climbs), but on flat
-ground its swivel lifts a rear wheel, so it does not steer as the thesis models.
+weight on the front wheels. So the batteries, motors and electronics (12 kg) sit in the
+central body at the apex, the rear axle housing is light, the differentials are open and the
+drive motor gives 20 N m: 21 kg, centre of mass at 47 % of the wheelbase, I_s 1.44 kg m^2
+(derived; the thesis' 0.84). The front is still the lighter axle, so on flat ground the
+swivel lifts a front wheel and the car steers as the thesis' offset tricycle, and the whole
+car climbs 7 cm in every benchmark climb, 8 cm in 91 %. ``config/designs/thesis_inertia.yaml``
+is the layout chosen only to match the thesis' I_s (heavy rear axle housing, centre of mass
+at 24 %, 10 N m): it climbs 6 cm.
 
 Swivel gains. Thesis Table 2 (kp 19 N m/rad, ki 11.45 N m/(rad s), kd 5.5 N m s/rad, the
 documented starting point and ``SwivelCarParams``' defaults) is far too soft for the simulated
@@ -96,17 +98,16 @@ class CarDescription:
         '[rad]')
     wheel_mass: float = described(0.5, 'mass of one wheel [kg]')
     body_mass: float = described(
-        2.495619701085839, 'central body (batteries, motors, electronics) at the apex [kg]')
+        12.0, 'central body (batteries, motors, electronics) at the apex [kg]')
     body_offset: float = described(
         0.0, 'central body centre forward of the apex, along base_link x [m]')
-    rear_axle_mass: float = described(12.704380298914161, 'rear axle housing with its '
-                                                       'differential [kg]')
+    rear_axle_mass: float = described(3.2, 'rear axle housing with its differential [kg]')
     front_axle_mass: float = described(1.9, 'front axle housing with its differential [kg]')
     column_mass: float = described(0.95, 'mass of each T column [kg]')
     front_differential: str = described('open', "front axle differential: 'open' or 'locked'")
     rear_differential: str = described('open', "rear axle differential: 'open' or 'locked'")
     drive_torque_limit: float = described(
-        10.0, 'largest total drive torque at the wheels (the drive motor) [N m]')
+        20.0, 'largest total drive torque at the wheels (the drive motor) [N m]')
     drive_speed_limit: float = described(20.0, 'largest drive speed at the wheels [rad/s]')
     swivel_torque_limit: float = described(30.0, 'peak torque of the swivel actuator [N m]')
     kp: float = described(150.0, 'swivel PID proportional gain [N m/rad]')

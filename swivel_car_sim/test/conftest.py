@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from swivel_car_sim.physics import RobotState, SwivelCarSim
@@ -12,17 +13,25 @@ CONTROL_STEPS = 5  # [1] physics steps per 0.01 s control period
 class SwivelHold:
     """Holds the swivel at a set point with a PD at 100 Hz, the way the controller drives
     the sim (the real controller lives in swivel_car_control; this one only keeps tests
-    independent of it). kd stays well below the discrete limit 2 I / dt with the front T's
-    inertia about the swivel axis, I = 0.036 kg m^2."""
+    independent of it): the description's kp and kd, the set point ramped at ``rate`` as the
+    controller ramps it. A stepped set point rolls the car over once its weight is forward:
+    the swivel overshoots to its joint limit and the rear body rolls onto one wheel."""
 
-    def __init__(self, sim: SwivelCarSim, kp: float = 60.0, kd: float = 2.0) -> None:
-        self.sim, self.kp, self.kd = sim, kp, kd
+    def __init__(self, sim: SwivelCarSim, rate: float = 1.5) -> None:
+        self.sim = sim
+        self.kp, self.kd = sim.description.kp, sim.description.kd
+        self.step_change = rate * CONTROL_STEPS * sim.config.time_step  # [rad] per control period
+        self.set_point: float | None = None  # [rad]
 
     def period(self, swivel_target: float, drive_speed: float) -> RobotState:
         """Command from the state now, advance one control period; returns the state
         before the period."""
         state = self.sim.state()
-        torque = self.kp * (swivel_target - state.positions[0]) - self.kd * state.velocities[0]
+        if self.set_point is None:
+            self.set_point = state.positions[0]
+        self.set_point += float(np.clip(swivel_target - self.set_point,
+                                        -self.step_change, self.step_change))
+        torque = self.kp * (self.set_point - state.positions[0]) - self.kd * state.velocities[0]
         self.sim.set_command(torque, drive_speed)
         self.sim.step(CONTROL_STEPS)
         return state

@@ -35,7 +35,8 @@ class ControllerConfig:
     max_integral_torque : float
         Clamp on the PID's integral contribution. # [N m]
     integral_band : float
-        The PID integrates only while |set point - measured| is below this. # [rad]
+        While the set point ramps, the PID integrates only while |set point - measured| is
+        below this (resting, it always integrates). # [rad]
     max_swivel_rate : float
         Set-point rate limit. # [rad/s]
     max_linear_velocity, max_linear_acceleration : float
@@ -292,7 +293,8 @@ class SwivelController:
                 drive_target = planar.wheel_rate_for_speed(self.p, speed)
         set_point = self._set_point.step(self._target, dt, max_rate)
         pid = (PidOutput(0.0, 0.0, 0.0, 0.0, False) if free
-               else self.pid.step(set_point, measured, measured_rate, dt))
+               else self.pid.step(set_point, measured, measured_rate, dt,
+                                  set_point_moving=set_point != self._target))
         scale = steering_speed_scale(self._target - measured, self.config.slowdown_start,
                                      self.config.slowdown_stop)
         drive = self._drive.step(drive_target * scale, dt)

@@ -29,8 +29,10 @@ class PidConfig:
     max_integral_torque : float
         Clamp on the integral contribution, >= 0. # [N m]
     integral_band : float
-        The integral only integrates while |error| is below this, > 0 (inf: always): during
-        large moves (the set point ramping away) it would only wind up. # [rad]
+        While the set point moves, the integral only integrates while |error| is below this,
+        > 0 (inf: always): during large moves (the set point ramping away) it would only wind
+        up. Once the set point rests it always integrates: a gravity load larger than
+        kp * integral_band must not leave the swivel short of its target. # [rad]
     """
 
     kp: float
@@ -65,9 +67,9 @@ class PidOutput:
 class SwivelPid:
     """PID with derivative on measurement, output clamp and conditional-integration anti-windup.
 
-    The integral only grows while the error is inside ``integral_band`` and the clamped output
-    is not pushing against its limit in the direction the error asks for, and it is itself
-    clamped to ``max_integral_torque``.
+    The integral only grows while the set point rests or the error is inside
+    ``integral_band``, and while the clamped output is not pushing against its limit in the
+    direction the error asks for; it is itself clamped to ``max_integral_torque``.
     """
 
     def __init__(self, config: PidConfig) -> None:
@@ -79,7 +81,7 @@ class SwivelPid:
         self._integral = 0.0
 
     def step(self, set_point: float, measured: float, measured_rate: float,
-             dt: float) -> PidOutput:
+             dt: float, set_point_moving: bool = False) -> PidOutput:
         """Torque for one control period.
 
         Parameters
@@ -90,6 +92,8 @@ class SwivelPid:
             Measured swivel rate. # [rad/s]
         dt : float
             Time since the previous step, >= 0 (0: no integration). # [s]
+        set_point_moving : bool
+            The set point is still on its way (a rate limiter ramping it).
         """
         for name, value in (('set_point', set_point), ('measured', measured),
                             ('measured_rate', measured_rate), ('dt', dt)):
@@ -101,7 +105,7 @@ class SwivelPid:
         error = set_point - measured
         p_term = c.kp * error
         d_term = -c.kd * measured_rate
-        integrating = abs(error) < c.integral_band
+        integrating = not set_point_moving or abs(error) < c.integral_band
         candidate = _clamp(self._integral + c.ki * error * dt * integrating,
                            c.max_integral_torque)
         unclamped = p_term + candidate + d_term
