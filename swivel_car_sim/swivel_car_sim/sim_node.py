@@ -150,6 +150,8 @@ class SimNode(Node):
     # --- callbacks -------------------------------------------------------------------------
 
     def _on_command(self, msg: ActuatorCommand) -> None:
+        if self._stale(msg.header.stamp):
+            return
         try:
             self.sim.set_command(msg.swivel_torque, msg.drive_speed)
         except ValueError as error:
@@ -161,6 +163,23 @@ class SimNode(Node):
         self._command_ready = True
         if not self._paused:
             self._advance_when_due()
+
+    def _stale(self, stamp) -> bool:
+        """A free-running sim drops a command computed more than ``watchdog_timeout`` of sim
+        time ago: it answers a state that old, and applying it steers open loop (at
+        ``real_time_factor`` 0 the controller falls 20x behind and the car spins). The watchdog
+        then stops the car. An unstamped command (stamp 0) counts as fresh."""
+        watchdog = self.config.physics.watchdog_timeout
+        computed = stamp.sec + 1e-9 * stamp.nanosec  # [s]
+        age = self.sim.time - computed  # [s]
+        if self.config.lockstep or watchdog == 0.0 or computed == 0.0 or age <= watchdog:
+            return False
+        self.get_logger().warn(
+            f'dropping actuator_command computed {age:.2f} s of sim time ago (watchdog_timeout '
+            f'{watchdog} s): the controller is behind the sim; free running with '
+            f'real_time_factor {self.config.real_time_factor}, lockstep keeps them together',
+            throttle_duration_sec=5.0)
+        return True
 
     def _on_set_paused(self, request: SetBool.Request, response: SetBool.Response):
         self._paused = request.data

@@ -9,6 +9,7 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from builtin_interfaces.msg import Time
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
 from nav_msgs.msg import Odometry
@@ -148,7 +149,7 @@ def _lockstep_run(h: Harness, periods: int) -> JointState:
         latest = h.joint_states[-1]
         if _ns(latest.header.stamp) not in answered:
             answered.add(_ns(latest.header.stamp))
-            h.command(latest.header.stamp, swivel_torque=20.0 * (0.4 - latest.position[0]),
+            h.command(latest.header.stamp, swivel_torque=60.0 * (0.4 - latest.position[0]),
                       drive_speed=4.0)
         h.executor.spin_once(timeout_sec=0.05)
     spin_until(h.executor, lambda: _ns(h.joint_states[-1].header.stamp) == periods * 10**7,
@@ -170,6 +171,24 @@ def test_real_time_free_running_advances_and_applies_commands(harness_factory):
     h.command(h.joint_states[-1].header.stamp, drive_speed=5.0)
     spin_until(h.executor, lambda: h.sim.sim.time > 0.2, TIMEOUT, 'free running')
     assert h.joint_states[-1].velocity[1] > 1.0
+
+
+def test_free_running_drops_a_command_computed_longer_ago_than_the_watchdog(harness_factory):
+    # Paused and stepped by hand: free running (no lockstep), but deterministic.
+    h = harness_factory(real_time_factor=0.0, start_paused=True, watchdog_timeout=0.5)
+    step = StepSimulation.Request(steps=300)  # 0.6 s
+    assert h.call(StepSimulation, 'step', step).success
+    h.command(Time(sec=0, nanosec=50_000_000), drive_speed=5.0)  # 0.55 s old
+    spin_until(h.executor, lambda: h.sim.sim.time > 0.0 and h.joint_states, TIMEOUT, 'states')
+    for _ in range(20):
+        h.executor.spin_once(timeout_sec=0.01)
+    assert h.call(StepSimulation, 'step', step).success
+    assert abs(h.sim.sim.state().velocities[1]) < 0.1
+    h.command(Time(sec=1, nanosec=100_000_000), drive_speed=5.0)  # 0.1 s old: applied
+    for _ in range(20):
+        h.executor.spin_once(timeout_sec=0.01)
+    assert h.call(StepSimulation, 'step', StepSimulation.Request(steps=100)).success
+    assert h.sim.sim.state().velocities[1] > 1.0
 
 
 def test_step_service_advances_lockstep_without_a_controller(harness_factory):
