@@ -12,6 +12,7 @@ busy-wait at full CPU while a climb ran.)
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, fields, replace
 
 from nav_msgs.msg import Odometry
@@ -20,6 +21,7 @@ from rclpy.time import Time
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.action.server import ServerGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.clock import Clock, ClockType
 from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
@@ -107,7 +109,10 @@ class PlannerNode(Node):
         self._received: dict[str, float] = {}  # topic -> sim time of its last message [s]
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
         self._last_tick = 0.0  # [s] node clock when the running climb last had a tick
+        self._last_tick_wall = 0.0  # [s] steady clock then
+        self._last_tick_stamp = 0.0  # [s] the stamp of that tick's inputs
         self._quiet_checks = 0  # input checks in a row that saw no tick
+        self._quiet_wall_checks = 0
 
         self.create_subscription(Odometry, 'odom', self._on_odom, 10)
         self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
@@ -124,6 +129,9 @@ class PlannerNode(Node):
             goal_callback=self._on_goal, cancel_callback=self._on_cancel,
             callback_group=requests)
         self.create_timer(self._ready_timeout / 4.0, self._check_inputs_alive)
+        # A dead sim stops /clock, and with it every sim-time timer: this one is not stopped.
+        self.create_timer(self._ready_timeout / 4.0, self._check_sim_alive,
+                          clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.get_logger().info(
             f'planner ready: model max scalable step {self._max_step():.3f} m, torque limit '
             f'{self.robot.swivel_torque_limit:.1f} N m')
@@ -245,7 +253,9 @@ class PlannerNode(Node):
             return self._failure(ErrorCode.BUSY, 'a climb is already running')
         self._climb = climb
         self._last_tick = self._now()
-        self._quiet_checks = 0
+        self._last_tick_wall = time.monotonic()
+        self._last_tick_stamp = -math.inf
+        self._quiet_checks = self._quiet_wall_checks = 0
         self.get_logger().info(
             f'climbing a {request.step_height:.3f} m step {request.step_distance:.2f} m ahead: '
             f'swivel {plan.swivel_angle:.3f} rad, approach heading '
@@ -267,8 +277,16 @@ class PlannerNode(Node):
         climb = self._climb
         if climb is None:
             return
+        if tick.time < self._last_tick_stamp:
+            self._abort(climb, tick.time, ErrorCode.NOT_READY,
+                        f'time went back from {self._last_tick_stamp:.2f} s to '
+                        f'{tick.time:.2f} s (a restarted sim?): the climb does not go on in '
+                        f'another world')
+            return
         self._last_tick = self._now()
-        self._quiet_checks = 0
+        self._last_tick_wall = time.monotonic()
+        self._last_tick_stamp = tick.time
+        self._quiet_checks = self._quiet_wall_checks = 0
         if climb.goal_handle is not None and climb.goal_handle.is_cancel_requested:
             climb.machine.cancel()
         command = climb.machine.update(inputs.observation(tick))
@@ -292,13 +310,31 @@ class PlannerNode(Node):
         if self._quiet_checks < 2 or now - self._last_tick <= self._ready_timeout:
             return
         missing = ', '.join(self._missing_inputs()) or 'none'
-        command = climb.machine.abort(
-            ErrorCode.NOT_READY, f'no complete input for {now - self._last_tick:.1f} s of sim '
-                                 f'time at {now:.2f} s; missing: {missing}; '
-                                 f'{self._sync.describe()}')
+        self._abort(climb, now, ErrorCode.NOT_READY,
+                    f'no complete input for {now - self._last_tick:.1f} s of sim time at '
+                    f'{now:.2f} s; missing: {missing}; {self._sync.describe()}')
+
+    def _check_sim_alive(self) -> None:
+        """A climb whose sim died (or was paused) ends after ``ready_timeout`` of wall time
+        without a tick: sim time stands still then, so the sim-time check never fires."""
+        climb = self._climb
+        if climb is None:
+            return
+        self._quiet_wall_checks += 1
+        quiet = time.monotonic() - self._last_tick_wall  # [s] wall
+        if self._quiet_wall_checks < 2 or quiet <= self._ready_timeout:
+            return
+        now = self._now()
+        self._abort(climb, now, ErrorCode.NOT_READY,
+                    f'no complete input for {quiet:.1f} s of wall time while sim time went '
+                    f'from {self._last_tick:.2f} s to {now:.2f} s: is the sim running (not '
+                    f'paused)? {self._sync.describe()}')
+
+    def _abort(self, climb: _ActiveClimb, stamp: float, code: ErrorCode, message: str) -> None:
+        command = climb.machine.abort(code, message)
         if command is not None:
-            self._publish_command(command, now)
-        self._end(climb, now)
+            self._publish_command(command, stamp)
+        self._end(climb, stamp)
 
     def _end(self, climb: _ActiveClimb, stamp: float) -> None:
         """After a failure the swivel holds where it is (the last command) and is released:

@@ -300,6 +300,31 @@ def test_inputs_stopping_mid_climb_abort_it(rig):
     spin_until(rig.executor, lambda: not rig.received[-1].hold, 10.0, 'the release')
 
 
+def test_a_dead_sim_ends_the_climb_within_ready_timeout_of_wall_time(rig):
+    rig.warm_up()
+    future = rig.call(**SUCCESSFUL_CLIMB)
+    rig.drive(_Deadline(rig, 1.0))
+    # Nothing more: no /clock, no inputs. Sim time stands still at 1.3 s.
+    start = time.monotonic()
+    response = result_of(rig, future)
+    waited = time.monotonic() - start  # [s] wall; a guard, not the measurement
+    assert response.error_code == ErrorCode.NOT_READY
+    assert 'wall time' in response.message and 'is the sim running' in response.message
+    assert waited < 10.0
+    spin_until(rig.executor, lambda: not rig.received[-1].hold, 10.0, 'the release')
+
+
+def test_a_restarted_sim_does_not_inherit_the_climb(rig):
+    rig.warm_up()
+    future = rig.call(**SUCCESSFUL_CLIMB)
+    rig.drive(_Deadline(rig, 1.0))
+    rig.car = KinematicCar()  # a new sim: the robot at the origin, its clock from 0 again
+    rig.warm_up(cycles=5)
+    response = result_of(rig, future)
+    assert response.error_code == ErrorCode.NOT_READY
+    assert 'time went back' in response.message
+
+
 class _Deadline:
     """A future-like that is done once the rig's car reaches ``seconds`` of sim time."""
 
