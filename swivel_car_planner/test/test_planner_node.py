@@ -75,7 +75,10 @@ class Rig:
 
     def _on_command(self, msg):
         self.received.append(msg)
-        self.command = Command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold)
+        # Only the answer to the state just published: a late answer to an earlier one
+        # would put the car out of step with the planner.
+        if msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec == self.car.cycles * 10**7:
+            self.command = Command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold)
 
     def publish_state(self, inputs=('joint_states', 'imu', 'odom', 'controller')):
         """One control cycle of the robot: clock, then the requested inputs."""
@@ -114,10 +117,10 @@ class Rig:
     def drive(self, future, seconds=120.0):
         """Close the loop until ``future`` is done: the car follows the planner's commands.
 
-        Lockstep by hand: each cycle waits for the planner's command of that cycle. Until a
-        climb is registered there is none (a short wait, then the car keeps the last one);
-        from its first command on the planner answers every state, so the wait is only a
-        guard and a loaded machine cannot put the car out of step with the planner.
+        Lockstep by hand: each cycle waits for the planner's command of that cycle (stamped
+        with its state). Until a climb is registered there is none (a short wait, then the
+        car keeps the last one); from its first command on the planner answers every state,
+        so the wait is only a guard and a loaded machine cannot put the car out of step.
         """
         last = Command(0.0, 0.0, 0.0, False)
         answering = False

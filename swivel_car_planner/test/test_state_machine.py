@@ -83,6 +83,26 @@ def test_the_climb_ends_only_once_the_car_stands_on_top():
     assert car.commands[-2].drive_speed == 0.0 and car.commands[-2].hold
 
 
+def test_a_car_still_tipping_when_its_wheels_stop_is_not_called_on_top():
+    # Measured in the sim (0.09 m steps): a rear wheel rode up onto the riser's corner and
+    # rolled back. Odometry (its wheel had spun) put it 0.2 m past the edge, and the wheels
+    # stopped just as the rocking car passed level (roll 0.03 rad); the IMU then showed it
+    # rolling on at 0.4 rad/s to 0.13 rad, where it came to rest on the corner.
+    machine, _ = start()
+    car = KinematicCar()
+    run(machine, car, until=lambda m, c: m.step == Step.STOP_ON_TOP)
+    stopped = None
+    while machine.outcome is None and car.time < 120.0:
+        if stopped is None and abs(car.speed) <= CONFIG.stop_speed:
+            stopped = car.time
+        since = 0.0 if stopped is None else car.time - stopped
+        car.roll = min(0.13, 0.03 + 0.4 * since)
+        car.apply(machine.update(car.observe()))
+    assert_safe_abort(machine, car, ErrorCode.FAILED)
+    assert 'rolled 0.130 rad' in machine.outcome.message
+    assert 'not on top' in machine.outcome.message
+
+
 def test_lift_starts_at_the_planned_distance_and_heading():
     machine, plan = start(yaw=0.2)
     car = KinematicCar()

@@ -23,7 +23,8 @@ action phase each one reports)::
                      the rear axle has no lift, it climbs by traction and
                      momentum only                                              CLIMB_REST
     STOP_ON_TOP      drive 0, the swivel held where it is, until odometry says
-                     the car stands; done if it is still level                  CLIMB_REST
+                     the car stands and the IMU's pitch and roll have been
+                     still for ``settle_time``; done if it is still level       CLIMB_REST
 
 Every step but APPROACH wants the *measured* swivel at an angle. Under load (a wheel lifted,
 or the front of the car lifted with one wheel on the step) the controller's PID settles short
@@ -187,6 +188,10 @@ class ClimbStateMachine:
         self._goal_error: float | None = None
         self._stall_ref = (0.0, math.inf)  # (time [s], best error [rad]) of the last headway
         self._at_rest_since: float | None = None
+        # STOP_ON_TOP: (since [s], pitch low, high, roll low, high [rad]) of the IMU while the
+        # wheels stand, and the first observation with them standing
+        self._attitude_window: tuple[float, float, float, float, float] | None = None
+        self._first_stop: Observation | None = None
         self._span = (0.0, 1.0)  # (start, end) of the quantity a step's progress follows
         self._cancel_requested = False
         self._hold_angle = 0.0  # [rad] swivel held after a failure
@@ -283,15 +288,17 @@ class ClimbStateMachine:
             return self._hold(obs, 0.0, 0.0)
         if step == Step.STOP_ON_TOP:
             if abs(obs.speed) > config.stop_speed:
+                self._attitude_window = None
+                return Command(self._last_command, config.swivel_rate, 0.0, True)
+            if self._first_stop is None:
+                self._first_stop = obs
+            if not self._attitude_steady(obs):
+                # The wheels stand but the body still tips: judged once it stops too.
                 return Command(self._last_command, config.swivel_rate, 0.0, True)
             # Roll gets twice the pitch's tolerance: the held swivel twists the car a little.
             rest = config.rest_tolerance
             if abs(obs.pitch) > rest or abs(obs.roll) > 2.0 * rest:
-                return self._finish(
-                    obs, ErrorCode.FAILED,
-                    f'the car came to rest pitched {obs.pitch:.3f} rad, rolled '
-                    f'{obs.roll:.3f} rad after the rear wheels passed the edge: a wheel is '
-                    f'not on top')
+                return self._finish(obs, ErrorCode.FAILED, self._not_on_top_message(obs))
             return self._finish(obs, ErrorCode.NONE,
                                 'climbed: all four wheels on top of the step, at rest')
         # REAR
@@ -324,6 +331,43 @@ class ClimbStateMachine:
         # meets the riser with its own load; held, it twisted a rear wheel off its traction
         # (docs/climbing_design.md).
         return self._open_loop(obs.swivel, config.rear_speed, free=True)
+
+    def _attitude_steady(self, obs: Observation) -> bool:
+        """The IMU's pitch and roll have stayed within ``settle_rate * settle_time`` of each
+        other for ``settle_time`` (the swivel's at-rest rate and time, applied to the body).
+
+        Odometry's speed alone does not say the car stands: a rear wheel that rode up onto
+        the riser's corner stops turning while the car still rocks on it, and the wheels can
+        stop just as the rocking car passes level (measured in the sim on 0.09 m steps: level
+        for an instant, rolled 0.13 and 0.31 rad once at rest).
+        """
+        config = self._config
+        band = config.settle_rate * config.settle_time  # [rad]
+        window = self._attitude_window
+        if window is not None:
+            since, low_pitch, high_pitch, low_roll, high_roll = window
+            low_pitch, high_pitch = min(low_pitch, obs.pitch), max(high_pitch, obs.pitch)
+            low_roll, high_roll = min(low_roll, obs.roll), max(high_roll, obs.roll)
+            if high_pitch - low_pitch <= band and high_roll - low_roll <= band:
+                self._attitude_window = (since, low_pitch, high_pitch, low_roll, high_roll)
+                return obs.time - since >= config.settle_time
+        self._attitude_window = (obs.time, obs.pitch, obs.pitch, obs.roll, obs.roll)
+        return config.settle_time <= 0.0
+
+    def _not_on_top_message(self, obs: Observation) -> str:
+        """What the planner saw of a car standing tilted after the rear step."""
+        message = (f'the car came to rest pitched {obs.pitch:.3f} rad, rolled '
+                   f'{obs.roll:.3f} rad although odometry puts the rear wheels '
+                   f'{self._rear_wheel_distance(obs):.2f} m past the edge: a wheel is not on '
+                   f'top')
+        first, rest = self._first_stop, self._config.rest_tolerance
+        if first is not None and first is not obs and abs(first.pitch) <= rest \
+                and abs(first.roll) <= 2.0 * rest:
+            message += (f' (when the wheels stopped it looked level, pitched '
+                        f'{first.pitch:.3f} rad, rolled {first.roll:.3f} rad, then it tipped '
+                        f'for {obs.time - first.time:.2f} s with the wheels standing: a rear '
+                        f'wheel had not come up, its spin counted as travel by odometry)')
+        return message
 
     def _first_move(self) -> Step:
         return Step.BACK_UP if self._plan.backup_distance > 0.0 else Step.APPROACH
