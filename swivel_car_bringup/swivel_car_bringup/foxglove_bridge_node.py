@@ -18,7 +18,7 @@ from ament_index_python.packages import get_package_share_directory
 from foxglove import Channel, Schema
 from foxglove.channels import FrameTransformsChannel
 from foxglove.messages import FrameTransform, FrameTransforms, Quaternion, Timestamp, Vector3
-from foxglove.websocket import ChannelView, Client
+from foxglove.websocket import ChannelView, Client, ServerListener
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
@@ -50,7 +50,7 @@ def _foxglove_transform(frame: Frame, stamp) -> FrameTransform:
                                               z=frame.rotation[2], w=frame.rotation[3]))
 
 
-class _Latching:
+class _Latching(ServerListener):
     """Sends the last message of a latched (transient local) topic to each new subscriber,
     as a ROS late subscriber would get it."""
 
@@ -108,9 +108,11 @@ class FoxgloveBridgeNode(Node):
 
         def forward(data: bytes) -> None:
             log_time = self.get_clock().now().nanoseconds
-            channel.log(data, log_time=log_time)
             if latched:
+                # Kept before it is sent: a client subscribing in between (on the server's
+                # thread) then gets it from on_subscribe; kept after, it got it from neither.
                 self._latching.last[channel.id()] = (channel, data, log_time)
+            channel.log(data, log_time=log_time)
 
         self.create_subscription(msg_class, topic, forward, qos, raw=True)
         self.get_logger().info(f'serving {topic} ({type_name})')

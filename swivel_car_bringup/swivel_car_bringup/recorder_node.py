@@ -1,9 +1,16 @@
 """recorder_node: records every topic of the stack (as they appear on the graph, ``/clock``
 included) into a rosbag2 bag with MCAP storage, each message stamped with its time of receipt
-on the node's clock (sim time with ``use_sim_time``), as ``ros2 bag record`` does."""
+on the node's clock (sim time with ``use_sim_time``), as ``ros2 bag record`` does.
+
+Stopping (SIGINT, SIGTERM) loses nothing the node has received: the callback under way
+finishes (the signal is not raised inside it, where it would drop the message or leave a
+half-written record in the .mcap), then the messages still queued in the subscriptions (the
+recorder may lag the publishers by many) are written before the bag is closed.
+"""
 
 from __future__ import annotations
 
+import signal
 import sys
 import time
 from pathlib import Path
@@ -89,7 +96,31 @@ class RecorderNode(Node):
                                     f'closed: {self._bag.path}')
             self._stop_reported = True
 
+    def drain(self) -> int:
+        """Handle the messages already queued in the subscriptions (``/clock`` included, so
+        that they are stamped with the latest time), as the executor would, one per
+        subscription in turn; the spin has ended. At most a queue's depth each, so that a
+        publisher still going cannot keep the node from closing. Returns how many."""
+        taken = 0
+        budget = {sub: max(sub.qos_profile.depth, 1) for sub in self.subscriptions}
+        while budget:
+            for sub in list(budget):
+                with sub.handle:
+                    received = sub.handle.take_message(sub.msg_type, sub.raw)
+                budget[sub] -= 1
+                if received is None or budget[sub] == 0:
+                    del budget[sub]
+                if received is not None:
+                    sub.callback(received[0])
+                    taken += 1
+        return taken
+
     def destroy_node(self) -> None:
+        queued = 0
+        try:
+            queued = self.drain()
+        except Exception as error:  # the bag must still be closed
+            self.get_logger().error(f'writing the queued messages failed: {error!r}')
         try:
             records = self._bag.close()
         except OSError as error:
@@ -98,11 +129,23 @@ class RecorderNode(Node):
             if records:
                 total = sum(r.count for r in records)
                 self.get_logger().info(f'closed {self._bag.path}: {total} messages on '
-                                       f'{len(records)} topics')
+                                       f'{len(records)} topics ({queued} queued at the stop)')
         super().destroy_node()
 
 
+def _stop_quietly(signum, frame) -> None:
+    """Python's part of a SIGINT/SIGTERM: nothing, so that no KeyboardInterrupt lands inside a
+    write. rclpy's handler, which calls this one, shuts the context down and wakes the
+    executor: the spin ends after the callback under way, and destroy_node drains the queues
+    and closes the bag. A second signal interrupts as usual (a stuck close)."""
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 def main(args=None) -> None:
+    # Before rclpy.init (in run_node): rclpy's handlers chain to these.
+    signal.signal(signal.SIGINT, _stop_quietly)
+    signal.signal(signal.SIGTERM, _stop_quietly)
     sys.exit(run_node(RecorderNode, 'recorder', args))
 
 
