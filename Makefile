@@ -7,7 +7,7 @@ STAMP := $(VENV)/.requirements-installed
 IN_WS := scripts/in_ws
 PYTEST_ARGS ?=
 
-.PHONY: setup build test demo figures bench clean
+.PHONY: setup build test demo figures bench soak clean
 
 setup: $(STAMP)
 
@@ -42,6 +42,10 @@ bench: build
 	$(IN_WS) python -m swivel_car_sim.benchmark
 	$(IN_WS) python -m swivel_car_control.benchmark
 	$(IN_WS) python -m swivel_car_bringup.climb_benchmark $(CLIMB_BENCH_ARGS)
+
+# Ten minutes of driving and climbs through the ROS stack: memory slope and message rates.
+soak: build
+	$(IN_WS) python scripts/soak.py
 
 clean:
 	rm -rf ros2_ws/build ros2_ws/install ros2_ws/log
