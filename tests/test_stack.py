@@ -193,3 +193,27 @@ def test_killed_planner_mid_climb_stops_the_car_and_a_restart_recovers(stack: St
     stack.spin_until(lambda: not stack.climb.service_is_ready(), 30.0, 'the planner to go')
     stack.processes['planner'] = stack.start('planner')
     stack.wait_planner_ready()
+
+
+def test_killed_sim_mid_climb_ends_the_climb_and_a_new_sim_inherits_nothing(stack: Stack):
+    stack.wait_planner_ready()
+    climb = stack.climb.call_async(ClimbStep.Request(
+        step_height=0.04, step_distance=1.0, step_yaw=0.0, plan_only=False))
+    stack.spin_until(lambda: stack.speed() > 0.1 or climb.done(), 60.0, 'the climb to drive')
+    assert not climb.done(), climb.result().message
+    stack.processes['sim'].kill()
+    del stack.processes['sim']
+    # Sim time stands still: the planner ends the climb on wall time (ready_timeout 1 s).
+    stack.spin_until(climb.done, 10.0, 'the climb to end without a sim')
+    assert climb.result().error_code == ClimbStep.Response.ERROR_NOT_READY
+    assert 'is the sim running' in climb.result().message
+
+    # A new sim (its clock from 0, the robot at the origin): nothing drives it on its own...
+    truth_before = len(stack.truth)
+    stack.processes['sim'] = stack.start('sim')
+    stack.spin_until(lambda: len(stack.truth) > truth_before, 60.0, 'the new sim')
+    stack.wait_sim_time(1.5, 'the new sim to run')
+    assert abs(stack.x()) < 0.01 and stack.speed() < 0.01
+    # ...and the stack drives it when asked.
+    stack.drive(0.3, 3.0)
+    assert stack.x() > 0.3, stack.processes['controller'].output()[-3000:]

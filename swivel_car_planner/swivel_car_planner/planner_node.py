@@ -283,6 +283,15 @@ class PlannerNode(Node):
                         f'{tick.time:.2f} s (a restarted sim?): the climb does not go on in '
                         f'another world')
             return
+        if math.isfinite(self._last_tick_stamp) \
+                and tick.time - self._last_tick_stamp > self._ready_timeout:
+            # Consecutive states are a control period apart: a leap is a bad stamp or a
+            # clock that jumped, and acting on it would time out or steer on a lie.
+            self._abort(climb, self._last_tick_stamp, ErrorCode.NOT_READY,
+                        f'the inputs leapt from {self._last_tick_stamp:.2f} s to '
+                        f'{tick.time:.2f} s, more than ready_timeout ({self._ready_timeout} '
+                        f's): not acted on')
+            return
         self._last_tick = self._now()
         self._last_tick_wall = time.monotonic()
         self._last_tick_stamp = tick.time

@@ -328,6 +328,22 @@ def test_a_restarted_sim_does_not_inherit_the_climb(rig):
     assert 'time went back' in response.message
 
 
+def test_a_moment_far_ahead_is_not_acted_on(rig):
+    rig.warm_up()
+    future = rig.call(**SUCCESSFUL_CLIMB)
+    rig.drive(_Deadline(rig, 1.0))
+    before = len(rig.received)
+    real = rig.car.cycles
+    rig.car.cycles = (2**31 - 1) * 100  # every input stamped 2^31-1 s, once
+    rig.publish_state()
+    rig.car.cycles = real
+    response = result_of(rig, future)
+    assert response.error_code == ErrorCode.NOT_READY
+    assert 'leapt' in response.message
+    # Nothing was steered on it: the only answers after it stop and release.
+    assert all(not m.hold or m.drive_speed == 0.0 for m in rig.received[before:])
+
+
 class _Deadline:
     """A future-like that is done once the rig's car reaches ``seconds`` of sim time."""
 
