@@ -217,3 +217,21 @@ def test_killed_sim_mid_climb_ends_the_climb_and_a_new_sim_inherits_nothing(stac
     # ...and the stack drives it when asked.
     stack.drive(0.3, 3.0)
     assert stack.x() > 0.3, stack.processes['controller'].output()[-3000:]
+
+
+def test_killed_odometry_mid_climb_ends_the_climb_and_a_restart_recovers(stack: Stack):
+    stack.wait_planner_ready()
+    climb = stack.climb.call_async(ClimbStep.Request(
+        step_height=0.04, step_distance=1.0, step_yaw=0.0, plan_only=False))
+    stack.spin_until(lambda: stack.speed() > 0.1 or climb.done(), 60.0, 'the climb to drive')
+    assert not climb.done(), climb.result().message
+    stack.processes['odometry'].kill()
+    del stack.processes['odometry']
+    stack.spin_until(climb.done, 30.0, 'the climb to end without odometry')
+    assert climb.result().error_code == ClimbStep.Response.ERROR_NOT_READY
+    assert 'odom' in climb.result().message
+    stack.wait_sim_time(1.0, 'the car to stop')
+    assert stack.speed() < 0.02
+
+    stack.processes['odometry'] = stack.start('odometry')
+    stack.wait_planner_ready()
