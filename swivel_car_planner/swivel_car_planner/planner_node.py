@@ -251,6 +251,10 @@ class PlannerNode(Node):
             Future(), goal_handle)
         if self._climb is not None:
             return self._failure(ErrorCode.BUSY, 'a climb is already running')
+        # The climb starts from the moments after this one: planning may have held the
+        # executor up (seconds, when a backup is searched), and a tick of the inputs
+        # collected before it would be that old.
+        self._sync.clear()
         self._climb = climb
         self._last_tick = self._now()
         self._last_tick_wall = time.monotonic()
