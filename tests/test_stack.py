@@ -95,6 +95,17 @@ class Stack:
                 return
             self.wait_sim_time(0.2, 'the planner to hear the stack')
 
+    def kill_mid_climb(self, name: str):
+        """Ask for a 4 cm climb, kill -9 node ``name`` once the car drives; returns the
+        climb's future."""
+        self.wait_planner_ready()
+        climb = self.climb.call_async(ClimbStep.Request(
+            step_height=0.04, step_distance=1.0, step_yaw=0.0, plan_only=False))
+        self.spin_until(lambda: self.speed() > 0.1 or climb.done(), 60.0, 'the climb to drive')
+        assert not climb.done(), climb.result().message
+        self.processes.pop(name).kill()
+        return climb
+
     def x(self) -> float:
         return self.truth[-1].pose.pose.position.x
 
@@ -155,8 +166,7 @@ def test_drive_then_climb_a_step(stack: Stack):
 def test_killed_controller_stops_the_car_and_a_restart_recovers(stack: Stack):
     stack.drive(0.3, 1.0)
     assert stack.speed() > 0.2
-    stack.processes['controller'].kill()
-    del stack.processes['controller']
+    stack.processes.pop('controller').kill()
     # The sim keeps running on its lockstep timeout; its watchdog stops the drive.
     clock_before = len(stack.clock)
     stack.wait_sim_time(1.5, 'the sim to go on without a controller')
@@ -174,15 +184,8 @@ def test_killed_controller_stops_the_car_and_a_restart_recovers(stack: Stack):
     assert stack.speed() < 0.01, 'a zero cmd_vel did not stop the car'
 
 
-
 def test_killed_planner_mid_climb_stops_the_car_and_a_restart_recovers(stack: Stack):
-    stack.wait_planner_ready()
-    climb = stack.climb.call_async(ClimbStep.Request(
-        step_height=0.04, step_distance=1.0, step_yaw=0.0, plan_only=False))
-    stack.spin_until(lambda: stack.speed() > 0.1 or climb.done(), 60.0, 'the climb to drive')
-    assert not climb.done(), climb.result().message
-    stack.processes['planner'].kill()
-    del stack.processes['planner']
+    climb = stack.kill_mid_climb('planner')
     # The controller's swivel_command deadman (0.5 s) stops the drive.
     stack.wait_sim_time(1.5, 'the car to stop without a planner')
     assert stack.speed() < 0.02
@@ -196,13 +199,7 @@ def test_killed_planner_mid_climb_stops_the_car_and_a_restart_recovers(stack: St
 
 
 def test_killed_sim_mid_climb_ends_the_climb_and_a_new_sim_inherits_nothing(stack: Stack):
-    stack.wait_planner_ready()
-    climb = stack.climb.call_async(ClimbStep.Request(
-        step_height=0.04, step_distance=1.0, step_yaw=0.0, plan_only=False))
-    stack.spin_until(lambda: stack.speed() > 0.1 or climb.done(), 60.0, 'the climb to drive')
-    assert not climb.done(), climb.result().message
-    stack.processes['sim'].kill()
-    del stack.processes['sim']
+    climb = stack.kill_mid_climb('sim')
     # Sim time stands still: the planner ends the climb on wall time (ready_timeout 1 s).
     stack.spin_until(climb.done, 10.0, 'the climb to end without a sim')
     assert climb.result().error_code == ClimbStep.Response.ERROR_NOT_READY
@@ -220,13 +217,7 @@ def test_killed_sim_mid_climb_ends_the_climb_and_a_new_sim_inherits_nothing(stac
 
 
 def test_killed_odometry_mid_climb_ends_the_climb_and_a_restart_recovers(stack: Stack):
-    stack.wait_planner_ready()
-    climb = stack.climb.call_async(ClimbStep.Request(
-        step_height=0.04, step_distance=1.0, step_yaw=0.0, plan_only=False))
-    stack.spin_until(lambda: stack.speed() > 0.1 or climb.done(), 60.0, 'the climb to drive')
-    assert not climb.done(), climb.result().message
-    stack.processes['odometry'].kill()
-    del stack.processes['odometry']
+    climb = stack.kill_mid_climb('odometry')
     stack.spin_until(climb.done, 30.0, 'the climb to end without odometry')
     assert climb.result().error_code == ClimbStep.Response.ERROR_NOT_READY
     assert 'odom' in climb.result().message

@@ -110,7 +110,7 @@ class PlannerNode(Node):
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
         self._last_tick = 0.0  # [s] node clock when the running climb last had a tick
         self._last_tick_wall = 0.0  # [s] steady clock then
-        self._last_tick_stamp = 0.0  # [s] the stamp of that tick's inputs
+        self._last_tick_stamp = -math.inf  # [s] the stamp of that tick's inputs
         self._quiet_checks = 0  # input checks in a row that saw no tick
         self._quiet_wall_checks = 0
 

@@ -77,7 +77,7 @@ class Rig:
         self.received.append(msg)
         # Only the answer to the state just published: a late answer to an earlier one
         # would put the car out of step with the planner.
-        if msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec == self.car.cycles * 10**7:
+        if rclpy.time.Time.from_msg(msg.header.stamp).nanoseconds == self.car.cycles * 10**7:
             self.command = Command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold)
 
     def publish_state(self, inputs=('joint_states', 'imu', 'odom', 'controller')):

@@ -10,6 +10,7 @@ from rclpy.clock import Clock, ClockType
 from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from rclpy.time import Time
 from rcl_interfaces.msg import ParameterDescriptor
 from rosgraph_msgs.msg import Clock as ClockMsg
 from nav_msgs.msg import Odometry
@@ -170,9 +171,9 @@ class SimNode(Node):
         ``real_time_factor`` 0 the controller falls 20x behind and the car spins). The watchdog
         then stops the car. An unstamped command (stamp 0) counts as fresh."""
         watchdog = self.config.physics.watchdog_timeout
-        computed = stamp.sec + 1e-9 * stamp.nanosec  # [s]
-        age = self.sim.time - computed  # [s]
-        if self.config.lockstep or watchdog == 0.0 or computed == 0.0 or age <= watchdog:
+        computed = Time.from_msg(stamp).nanoseconds
+        age = (self.sim.steps * self._time_step_ns - computed) * 1e-9  # [s]
+        if self.config.lockstep or watchdog == 0.0 or computed == 0 or age <= watchdog:
             return False
         self.get_logger().warn(
             f'dropping actuator_command computed {age:.2f} s of sim time ago (watchdog_timeout '
