@@ -5,10 +5,21 @@ With --import-mode=importlib pytest names a test module after its path
 stand-ins into sys.modules for parents it has not seen, which would hide the real
 swivel_car_sim package from the tests. Importing the real packages first prevents that, and
 lets same-named test files (test_system.py) live in several packages.
+
+Hypothesis draws the same examples on every run, so a test run's result depends on the code
+alone (HYPOTHESIS_PROFILE=explore draws new ones, for looking for bugs by hand).
 """
+
+import os
+
+from hypothesis import settings
 
 import swivel_car_bringup  # noqa: F401
 import swivel_car_control  # noqa: F401
 import swivel_car_model  # noqa: F401
 import swivel_car_planner  # noqa: F401
 import swivel_car_sim  # noqa: F401
+
+settings.register_profile('deterministic', derandomize=True)
+settings.register_profile('explore', derandomize=False)
+settings.load_profile(os.environ.get('HYPOTHESIS_PROFILE', 'deterministic'))

@@ -267,7 +267,8 @@ def test_every_plan_keeps_its_margins_or_says_why_not(height, yaw):
         plan = make_plan(P, FRONT, request(height, distance=3.0, yaw=yaw))
     except PlanError as error:
         assert error.code in (ErrorCode.UNREACHABLE_HEIGHT, ErrorCode.TIP_OVER,
-                              ErrorCode.TORQUE_LIMIT, ErrorCode.INVALID_REQUEST)
+                              ErrorCode.TORQUE_LIMIT, ErrorCode.WHEEL_INTERFERENCE,
+                              ErrorCode.INVALID_REQUEST)
         assert error.message
         return
     assert plan.wheel_clearance >= FRONT.clearance_margin - 1e-9
