@@ -33,6 +33,10 @@ class JointReader:
     def __init__(self, names: Sequence[str]) -> None:
         self.names = tuple(names)
         self._previous: dict[str, tuple[float, float]] = {}  # name -> (time [s], position)
+        # The message layout last seen and where the wanted joints sit in it: a driver sends
+        # the same names in every message, so they are looked up once.
+        self._layout: tuple[str, ...] | None = None
+        self._indices: tuple[int | None, ...] = ()
 
     def reset(self) -> None:
         """Forget previous positions (e.g. after time jumped back)."""
@@ -49,18 +53,19 @@ class JointReader:
             it has no velocity and no earlier sample to difference against (its position is
             remembered for the next message).
         """
-        index = {name: i for i, name in enumerate(names)}
-        positions_now: dict[str, float] = {}
-        rates_now: dict[str, float] = {}
-        for name in self.names:
-            i = index.get(name)
+        layout = tuple(names)
+        if layout != self._layout:
+            index = {name: i for i, name in enumerate(layout)}
+            self._indices = tuple(index.get(name) for name in self.names)
+            self._layout = layout
+        readings = []
+        for name, i in zip(self.names, self._indices):
             if i is None or i >= len(positions) or not math.isfinite(positions[i]):
                 raise MissingJointError(f'joint {name!r} missing or without a finite position')
-            positions_now[name] = float(positions[i])
-            rates_now[name] = float(velocities[i]) if i < len(velocities) else math.nan
+            readings.append((name, float(positions[i]),
+                             float(velocities[i]) if i < len(velocities) else math.nan))
         samples: dict[str, JointSample] = {}
-        for name, position in positions_now.items():
-            rate = rates_now[name]
+        for name, position, rate in readings:
             if not math.isfinite(rate):
                 previous = self._previous.get(name)
                 if previous is None or t <= previous[0]:
@@ -70,7 +75,7 @@ class JointReader:
                     rate = step / (t - previous[0])
             samples[name] = JointSample(position, rate)
         # Positions are kept even when a rate is missing, so the next message can difference.
-        for name, position in positions_now.items():
+        for name, position, _ in readings:
             self._previous[name] = (t, position)
         missing = [name for name, sample in samples.items() if not math.isfinite(sample.rate)]
         if missing:

@@ -396,8 +396,10 @@ def tip_over_margin(p: SwivelCarParams, theta1: ArrayLike) -> ArrayLike:
 
     The apex (mass point C_m) stays ahead of the rear axle while this is positive.
     """
-    t1 = _check_finite('theta1', theta1)
-    return _as_output(math.pi / 2.0 - p.phi / 2.0 - t1, t1)
+    scalar = isinstance(theta1, float) and math.isfinite(theta1)  # per-call: skip numpy
+    t1 = theta1 if scalar else _check_finite('theta1', theta1)
+    margin = math.pi / 2.0 - p.phi / 2.0 - t1
+    return margin if scalar else _as_output(margin, t1)
 
 
 def interference_margin(p: SwivelCarParams, theta1: ArrayLike) -> ArrayLike:

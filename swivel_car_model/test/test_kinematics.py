@@ -217,6 +217,10 @@ def test_margins_follow_eqs_72_and_75():
     assert k.tip_over_margin(DEFAULT, math.pi / 2 - DEFAULT.phi / 2) == pytest.approx(0.0)
     assert k.interference_margin(DEFAULT, 0.0) == pytest.approx(
         DEFAULT.wheelbase - DEFAULT.h * math.sin(DEFAULT.phi / 2))
+    # A float takes the scalar path (no numpy): the same numbers as an array.
+    theta1 = [0.0, 0.2, -0.1]
+    assert k.tip_over_margin(DEFAULT, np.array(theta1)).tolist() == [
+        k.tip_over_margin(DEFAULT, t) for t in theta1]
 
 
 @pytest.mark.parametrize('func', [k.lift_angle, k.steering_angle, k.contact_point,

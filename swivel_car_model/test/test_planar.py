@@ -10,6 +10,7 @@ from swivel_car_model import kinematics, planar
 from swivel_car_model.params import SwivelCarParams
 
 P = SwivelCarParams()
+MODEL = planar.tabulated_model(P)
 LIMIT = 1.4  # [rad] a swivel range well clear of the singular pi/2
 
 angles = st.floats(-LIMIT, LIMIT, allow_nan=False)
@@ -84,18 +85,20 @@ def test_swivel_sweep_without_rolling_does_not_move_base_link():
 
 def _drive(odometry, swivel_of_t, wheel_rate_of_t, duration, dt):
     """Feed the odometry a trajectory; return the world positions of the contact point."""
-    contacts, headings, sides = [], [], []
+    poses, swivels = [], []
     for k in range(int(round(duration / dt)) + 1):
         t = k * dt
         theta2 = swivel_of_t(t)
         rate = (swivel_of_t(t + 1e-6) - swivel_of_t(t - 1e-6)) / 2e-6
         odometry.update(theta2, rate, wheel_rate_of_t(t), dt if k else 0.0)
-        a, b = kinematics.contact_point(P, theta2)
-        c, s = math.cos(odometry.yaw), math.sin(odometry.yaw)
-        contacts.append((odometry.x + c * a - s * b, odometry.y + s * a + c * b))
-        headings.append(odometry.yaw + kinematics.steering_angle(P, theta2))
-        sides.append(theta2 >= 0.0)
-    return np.array(contacts), np.array(headings), np.array(sides)
+        poses.append((odometry.x, odometry.y, odometry.yaw))
+        swivels.append(theta2)
+    x, y, yaw = np.array(poses).T
+    swivels = np.array(swivels)
+    a, b = kinematics.contact_point(P, swivels)  # exact, vectorised: the reference
+    c, s = np.cos(yaw), np.sin(yaw)
+    contacts = np.stack([x + c * a - s * b, y + s * a + c * b], axis=1)
+    return contacts, yaw + kinematics.steering_angle(P, swivels), swivels >= 0.0
 
 
 def test_steering_wheel_never_skids_while_the_swivel_moves():
@@ -120,7 +123,8 @@ def test_steering_wheel_never_skids_while_the_swivel_moves():
 def test_constant_swivel_drives_a_closed_circle(theta2):
     odometry = planar.OffsetTricycleOdometry(P)
     wheel_rate = 3.0  # [rad/s]
-    v, omega = planar.body_twist(P, theta2, 0.0, wheel_rate)
+    # The circle of the odometry's own (tabulated) twist: this checks the integration.
+    v, omega = MODEL.body_twist(theta2, 0.0, wheel_rate)
     period = 2.0 * math.pi / abs(omega)
     steps = 1000
     positions = []
@@ -128,7 +132,7 @@ def test_constant_swivel_drives_a_closed_circle(theta2):
         odometry.update(theta2, 0.0, wheel_rate, period / steps if k else 0.0)
         positions.append((odometry.x, odometry.y))
     positions = np.array(positions)
-    radius = 1.0 / planar.curvature_for_swivel(P, theta2)
+    radius = 1.0 / MODEL.curvature(theta2)
     # Centre of rotation on the rear axle line at y = 1 / curvature.
     assert np.allclose(np.hypot(positions[:, 0], positions[:, 1] - radius), abs(radius),
                        atol=1e-9)
@@ -203,3 +207,66 @@ def test_wheel_rate_for_speed():
     assert planar.wheel_rate_for_speed(P, 0.3) == pytest.approx(0.3 / P.r)
     with pytest.raises(ValueError):
         planar.wheel_rate_for_speed(P, math.nan)
+
+
+# --- the tabulated model against the exact one ----------------------------------------------
+# The bounds TabulatedModel's docstring states; the odometry's own error on the benchmark
+# routes is 0.04-0.7 % of the distance, so 1e-6 relative in the twist is far below it.
+
+def test_tabulated_geometry_is_the_exact_geometry_over_the_whole_swivel_range():
+    # 4000 angles, none on a table sample but the last: the worst case lies between samples.
+    # (0 and -0.0 are the positive side's, as in the exact model: the twist test has them.)
+    u = np.linspace(0.0, P.max_swivel_angle, 4001)[1:]
+    exact = np.array(planar._geometry_arrays(P, u))
+    lift = np.asarray(kinematics.lift_angle(P, u))
+    for sign in (1.0, -1.0):
+        tabulated = np.array([MODEL.geometry(sign * x) for x in u]).T
+        mirrored = exact * np.array([1.0, sign, sign, sign, 1.0, sign])[:, None]
+        error = np.max(np.abs(tabulated - mirrored), axis=1)
+        assert np.all(error[:2] < 1e-8)  # contact point [m]
+        assert error[2] < 1e-7  # steering angle [rad]
+        assert np.all(error[3:] < 1e-6)  # derivatives [m/rad], [1]
+        tabulated_lift = np.array([MODEL.lift_angle(sign * x) for x in u])
+        assert np.max(np.abs(tabulated_lift - lift)) < 1e-8  # [rad]
+
+
+@pytest.mark.parametrize('p', [P, SwivelCarParams(phi=-math.pi / 3, h=0.1, r=0.05)])
+def test_tabulated_twist_and_curvature_match_the_exact_ones(p):
+    model = planar.tabulated_model(p)
+    rng = np.random.default_rng(3)
+    for theta2 in np.append(np.linspace(-1.55, 1.55, 32), [0.0, 1e-7, -1e-7]):
+        rate, wheel_rate = rng.uniform(-2.0, 2.0), rng.uniform(-8.0, 8.0)
+        v, omega = planar.body_twist(p, theta2, rate, wheel_rate)
+        scale = abs(v) + abs(omega)
+        assert model.body_twist(theta2, rate, wheel_rate) == pytest.approx(
+            (v, omega), rel=1e-6, abs=1e-9 * scale)
+        assert model.curvature(theta2) == pytest.approx(planar.curvature_for_swivel(p, theta2),
+                                                        rel=1e-6, abs=1e-9)
+
+
+@pytest.mark.parametrize('p', [P, SwivelCarParams(phi=-math.pi / 3)])
+def test_tabulated_swivel_for_curvature_inverts_the_exact_curvature(p):
+    model = planar.tabulated_model(p)
+    for theta2 in np.linspace(-LIMIT, LIMIT, 57):
+        curvature = planar.curvature_for_swivel(p, theta2)
+        assert model.swivel_for_curvature(curvature, LIMIT) == pytest.approx(theta2, abs=1e-7)
+    assert model.swivel_for_curvature(0.0, LIMIT) == 0.0
+    reachable = planar.max_curvature(p, LIMIT)
+    assert abs(model.swivel_for_curvature(reachable, LIMIT)) == pytest.approx(LIMIT, abs=1e-7)
+    for bad in (1.01 * reachable, 1e9, math.nan, math.inf):
+        with pytest.raises(ValueError, match='beyond|finite'):
+            model.swivel_for_curvature(bad, LIMIT)
+
+
+def test_tabulated_model_rejects_what_the_exact_one_rejects():
+    for args in ((math.nan, 0.0, 1.0), (0.1, math.inf, 1.0), (0.1, 0.0, -math.inf),
+                 (P.max_swivel_angle + 0.01, 0.0, 1.0), (-math.inf, 0.0, 1.0)):
+        with pytest.raises(ValueError):
+            MODEL.body_twist(*args)
+    with pytest.raises(ValueError, match='finite and within'):
+        MODEL.lift_angle(math.nan)
+    with pytest.raises(ValueError, match='not determined'):
+        MODEL.curvature(math.pi / 2)
+    with pytest.raises(ValueError, match='overflows'):
+        MODEL.body_twist(0.3, -1.7e308, 1.7e308)
+    assert planar.tabulated_model(SwivelCarParams()) is MODEL

@@ -234,6 +234,10 @@ class SwivelCarSim:
         self.gains = DriveGains.for_robot(self.params, self.config.time_step)
         self._rear_locked = self.description.rear_differential == 'locked'
         self._front_locked = self.description.front_differential == 'locked'
+        # Read every physics step (_apply_actuators).
+        self._time_step = self.config.time_step  # [s]
+        self._watchdog_timeout = self.config.watchdog_timeout  # [s]
+        self._drive_torque_limit = self.description.drive_torque_limit  # [N m]
         self._client = pybullet.connect(pybullet.GUI if self.config.gui else pybullet.DIRECT)
         if self._client < 0:
             raise RuntimeError('pybullet could not connect' + (' a GUI (is there a display?)'
@@ -302,8 +306,9 @@ class SwivelCarSim:
     @property
     def watchdog_tripped(self) -> bool:
         """True while the last command is older than the watchdog timeout."""
-        timeout = self.config.watchdog_timeout
-        return timeout > 0.0 and self.time - self._command_time > timeout + 1e-9
+        timeout = self._watchdog_timeout
+        return timeout > 0.0 and self._steps * self._time_step - self._command_time > \
+            timeout + 1e-9
 
     def step(self, steps: int = 1) -> None:
         """Advance the physics by ``steps`` time steps (1 .. 100000)."""
@@ -316,13 +321,16 @@ class SwivelCarSim:
             pybullet.stepSimulation(physicsClientId=self._client)
             self._steps += 1
         v_end = self._base_velocity_world()[0]
-        self._acceleration = (v_end - v_start) / (steps * self.config.time_step)
+        span = steps * self.config.time_step  # [s]
+        self._acceleration = np.array([(end - start) / span
+                                       for start, end in zip(v_start, v_end)])
 
     def _apply_actuators(self) -> None:
-        # The hot loop (every physics step): plain floats and direct pybullet calls, since
-        # numpy on four numbers costs more than the physics step itself.
+        # The hot loop (every physics step): plain floats, direct pybullet calls and the
+        # constants looked up once, since numpy on four numbers costs more than the physics
+        # step itself.
         g = self.gains
-        dt = self.config.time_step
+        dt = self._time_step
         rl, rr, fl, fr = pybullet.getJointStates(self._body, self._wheel_ids,
                                                  physicsClientId=self._client)
         if self.watchdog_tripped:
@@ -331,7 +339,7 @@ class SwivelCarSim:
             swivel_torque, drive_speed = self._swivel_torque, self._drive_speed
         rear_speed, front_speed = (rl[1] + rr[1]) / 2.0, (fl[1] + fr[1]) / 2.0
         error = drive_speed - rear_speed
-        limit = self.description.drive_torque_limit
+        limit = self._drive_torque_limit
         unsaturated = g.speed_p * error + g.speed_i * (self._speed_integral + error * dt)
         motor = min(limit, max(-limit, unsaturated))
         if motor == unsaturated:
@@ -404,23 +412,27 @@ class SwivelCarSim:
         pos, orn = pybullet.multiplyTransforms(com_pos, com_orn, *self._link_in_com)
         return np.array(pos), np.array(orn)
 
-    def _base_velocity_world(self) -> tuple[np.ndarray, np.ndarray]:
-        """base_link origin velocity and angular velocity in the world frame."""
-        com_pos, com_orn = self._pb.getBasePositionAndOrientation(self._body)
-        linear, angular = self._pb.getBaseVelocity(self._body)
+    def _base_velocity_world(self) -> tuple[tuple[float, float, float],
+                                            tuple[float, float, float]]:
+        """base_link origin velocity and angular velocity in the world frame (floats: it
+        runs twice per ``step``)."""
+        client = self._client
+        com_pos, com_orn = pybullet.getBasePositionAndOrientation(self._body,
+                                                                  physicsClientId=client)
+        linear, angular = pybullet.getBaseVelocity(self._body, physicsClientId=client)
         pos, _ = pybullet.multiplyTransforms(com_pos, com_orn, *self._link_in_com)
         # v_origin = v_com + omega x (origin - com)
         dx, dy, dz = pos[0] - com_pos[0], pos[1] - com_pos[1], pos[2] - com_pos[2]
         wx, wy, wz = angular
-        return (np.array([linear[0] + wy * dz - wz * dy, linear[1] + wz * dx - wx * dz,
-                          linear[2] + wx * dy - wy * dx]), np.array(angular))
+        return ((linear[0] + wy * dz - wz * dy, linear[1] + wz * dx - wx * dz,
+                 linear[2] + wx * dy - wy * dx), angular)
 
     def state(self) -> RobotState:
         """The sensors and the ground truth now."""
         states = self._pb.getJointStates(self._body, self._joint_ids)
         pos, orn = self._base_pose()
         rotation = np.array(pybullet.getMatrixFromQuaternion(orn)).reshape(3, 3)
-        linear, angular = self._base_velocity_world()
+        linear, angular = (np.array(v) for v in self._base_velocity_world())
         specific_force = self._acceleration + np.array([0.0, 0.0, GRAVITY])
         return RobotState(
             time=self.time, joint_names=self.joint_names,

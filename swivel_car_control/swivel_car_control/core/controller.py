@@ -140,6 +140,7 @@ class SwivelController:
         self.swivel_limit = tip_safe_swivel_limit(p, p.swivel_limit,
                                                   config.tip_over_margin)  # [rad]
         self.steering = SteeringMap(p, self.swivel_limit, config.max_linear_velocity)
+        self._model = self.steering.model
         self.pid = SwivelPid(PidConfig(p.kp, p.ki, p.kd, config.max_torque,
                                        config.max_integral_torque, config.integral_band))
         self._v = SlewLimiter(config.max_linear_velocity, config.max_linear_acceleration)
@@ -215,7 +216,7 @@ class SwivelController:
         # Beyond the tip-safe limit the way there crosses unsafe angles even where the target
         # itself would be safe (the lift angle peaks inside the swivel range).
         if abs(angle) > self.swivel_limit or not swivel_is_tip_safe(
-                self.p, angle, self.config.tip_over_margin):
+                self._model, angle, self.config.tip_over_margin):
             raise ValueError(
                 f'swivel_command angle {angle!r} rad breaks the tip-over rule (thesis eq. 72) '
                 f'with margin {self.config.tip_over_margin!r} rad: refused')
@@ -299,7 +300,7 @@ class SwivelController:
                                      self.config.slowdown_stop)
         drive = self._drive.step(drive_target * scale, dt)
         v_out = drive * self.p.r
-        omega_out = planar.curvature_for_swivel(self.p, self._target) * v_out
+        omega_out = self._model.curvature(self._target) * v_out
         return ControlOutput(pid.torque, drive, set_point, self._target, pid, source, v_out,
                              omega_out, timed_out, command_timed_out)
 
@@ -312,7 +313,7 @@ class SwivelController:
         the speed only serves the yaw rate, so it follows the measured curvature.
         """
         limit = self.p.max_swivel_angle
-        curvature = planar.curvature_for_swivel(self.p, max(-limit, min(limit, measured)))
+        curvature = self._model.curvature(max(-limit, min(limit, measured)))
         if curvature * omega <= 0.0 or abs(curvature) < 0.5 * self.steering.max_curvature:
             return 0.0  # still steering towards the turn: the speed scale holds the drive
         return max(-self.config.max_linear_velocity,
