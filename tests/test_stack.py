@@ -83,15 +83,17 @@ class Stack:
             self.wait_sim_time(0.05, 'sim time while driving')
 
     def wait_planner_ready(self) -> None:
-        """Until the planner hears the whole stack: a plan-only request is answered, not
-        refused as NOT_READY."""
+        """Until the planner hears the whole stack: a climb out of reach is refused as
+        unreachable (without motion), not as NOT_READY. (A plan-only request is answered
+        before the planner hears anything.)"""
         self.spin_until(self.climb.service_is_ready, 60.0, 'the climb_step service')
         while True:
             future = self.climb.call_async(ClimbStep.Request(
-                step_height=0.04, step_distance=1.0, step_yaw=0.0, plan_only=True))
-            self.spin_until(future.done, 30.0, 'a plan')
+                step_height=10.0, step_distance=1.0, step_yaw=0.0, plan_only=False))
+            self.spin_until(future.done, 30.0, 'a refusal')
             if future.result().error_code != ClimbStep.Response.ERROR_NOT_READY:
-                assert future.result().success, future.result().message
+                assert future.result().error_code == \
+                    ClimbStep.Response.ERROR_UNREACHABLE_HEIGHT, future.result().message
                 return
             self.wait_sim_time(0.2, 'the planner to hear the stack')
 

@@ -11,24 +11,25 @@ busy-wait at full CPU while a climb ran.)
 
 from __future__ import annotations
 
+import sys
+
 import math
 import time
 from dataclasses import dataclass, fields, replace
 
 from nav_msgs.msg import Odometry
-import rclpy
 from rclpy.time import Time
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.action.server import ServerGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.clock import Clock, ClockType
-from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException
+from rclpy.executors import SingleThreadedExecutor
+from swivel_car_control.ros_params import run_node
 from rclpy.node import Node
 from rclpy.task import Future
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from sensor_msgs.msg import Imu, JointState
-from swivel_car_model import kinematics
+from swivel_car_model import dynamics, kinematics
 from swivel_car_model import description
 from swivel_car_model.description import CarDescription
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
@@ -132,6 +133,9 @@ class PlannerNode(Node):
         # A dead sim stops /clock, and with it every sim-time timer: this one is not stopped.
         self.create_timer(self._ready_timeout / 4.0, self._check_sim_alive,
                           clock=Clock(clock_type=ClockType.STEADY_TIME))
+        # The model's swivel drift is integrated once per robot (a second); done now, the first
+        # climb request does not hold the executor up while the stack waits for its commands.
+        dynamics.swivel_pose_drift(self.robot, 0.0, self.robot.max_swivel_angle)
         self.get_logger().info(
             f'planner ready: model max scalable step {self._max_step():.3f} m, torque limit '
             f'{self.robot.swivel_torque_limit:.1f} N m')
@@ -410,27 +414,8 @@ class PlannerNode(Node):
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
-    node = None
-    code = 0
-    try:
-        node = PlannerNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except Exception as error:
-        if not rclpy.ok():
-            pass  # SIGINT/SIGTERM shut the context under a callback: "context is invalid"
-        elif isinstance(error, (ValueError, ParameterException)):
-            rclpy.logging.get_logger('planner').fatal(f'bad configuration: {error}')
-            code = 1
-        else:
-            raise
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    raise SystemExit(code)
+    # Its service callback awaits the climb, which the EventsExecutor cannot run.
+    sys.exit(run_node(PlannerNode, 'planner', args, SingleThreadedExecutor))
 
 
 if __name__ == '__main__':

@@ -3,12 +3,12 @@ would offer, owner of /clock, with a deterministic lockstep mode (docs/architect
 
 from __future__ import annotations
 
+import sys
+
 import time
 
-import rclpy
 from rclpy.clock import Clock, ClockType
-from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException
+from swivel_car_control.ros_params import run_node
 from rclpy.node import Node
 from rclpy.time import Time
 from rcl_interfaces.msg import ParameterDescriptor
@@ -253,25 +253,7 @@ class SimNode(Node):
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = SimNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except Exception as error:
-        if not rclpy.ok():
-            pass  # SIGINT/SIGTERM shut the context under a callback: "context is invalid"
-        elif isinstance(error, (ValueError, ParameterException)):
-            rclpy.logging.get_logger('sim').fatal(str(error))
-            raise SystemExit(1) from None
-        else:
-            raise
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    sys.exit(run_node(SimNode, 'sim', args))
 
 
 if __name__ == '__main__':
