@@ -29,7 +29,7 @@ from std_msgs.msg import String
 from swivel_car_bringup.bag import MessageDefinitions, UnknownTypeError
 from swivel_car_bringup.robot_frames import fixed_frames, Frame, moving_frames, parse_joints
 from swivel_car_bringup.topics import message_class, subscription_qos, TopicWatcher
-from swivel_car_control.ros_params import refuse_runtime_changes, run_node
+from swivel_car_ros.ros_params import refuse_runtime_changes, run_node
 
 PARAMETERS = {
     'host': ('127.0.0.1', "address to serve on; '0.0.0.0' for other machines"),

@@ -25,7 +25,7 @@ from rosbags.interfaces import (
 from swivel_car_bringup.bag import BagWriter, MessageDefinitions, UnknownTypeError
 from swivel_car_bringup.topics import DEFAULT_EXCLUDED, message_class, subscription_qos, \
     TopicWatcher
-from swivel_car_control.ros_params import refuse_runtime_changes, run_node
+from swivel_car_ros.ros_params import refuse_runtime_changes, run_node
 
 PARAMETERS = {
     'output': ('', "bag directory to create; '' = rosbag2_<date>_<time> in the working "

@@ -20,7 +20,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 
 from swivel_car_bringup.robot_frames import fixed_frames, Frame, moving_frames, parse_joints
-from swivel_car_control.ros_params import declare_description, refuse_runtime_changes, \
+from swivel_car_ros.ros_params import declare_description, refuse_runtime_changes, \
     run_node
 from swivel_car_model.description import ROBOT_VARIANTS
 from swivel_car_sim.urdf import build_robot

@@ -19,7 +19,7 @@ from swivel_car_control.conversions import is_zero_stamp, stamp_to_seconds
 from swivel_car_control.core.controller import ControllerConfig, SwivelController
 from swivel_car_control.core.joint_states import JointStateController
 from swivel_car_control.joints import MissingJointError
-from swivel_car_control.ros_params import (
+from swivel_car_ros.ros_params import (
     declare_dataclass, declare_description, live_parameters, run_node)
 
 # A cmd_vel stamped further than this ahead of the node clock is taken as arriving now.

@@ -21,7 +21,7 @@ from swivel_car_control.core.joint_states import JointStateOdometry, YAW_RATE_SO
 from swivel_car_control.core.odometry_input import (
     GatedOdometry, MAX_SWIVEL_RATE, Verdict, WHEEL_RATE_FACTOR)
 from swivel_car_control.joints import MissingJointError
-from swivel_car_control.ros_params import (
+from swivel_car_ros.ros_params import (
     declare_dataclass, declare_description, live_parameters, run_node)
 
 

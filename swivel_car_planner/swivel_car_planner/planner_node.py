@@ -24,14 +24,12 @@ from rclpy.action.server import ServerGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.clock import Clock, ClockType
 from rclpy.executors import SingleThreadedExecutor
-from swivel_car_control.ros_params import run_node
+from swivel_car_ros.ros_params import declare_description, run_node
 from rclpy.node import Node
 from rclpy.task import Future
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from sensor_msgs.msg import Imu, JointState
 from swivel_car_model import dynamics, kinematics
-from swivel_car_model import description
-from swivel_car_model.description import CarDescription
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
@@ -87,11 +85,7 @@ class PlannerNode(Node):
             for item in fields(PlannerConfig)})
         self.add_on_set_parameters_callback(self._check_config)
         self.add_post_set_parameters_callback(self._apply_config)
-        self.description = CarDescription.from_values({
-            name: self.declare_parameter(
-                name, default, ParameterDescriptor(description=text, dynamic_typing=True,
-                                                   read_only=True)).value
-            for name, (default, text) in description.PARAMETERS.items()})
+        self.description = declare_description(self)
         self.robot = self.description.model_params()
         self.whole_car_limit = self._load_capability(self.declare_parameter(
             'capability_file', capability.INSTALLED, ParameterDescriptor(

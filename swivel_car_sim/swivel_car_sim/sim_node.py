@@ -8,7 +8,7 @@ import sys
 import time
 
 from rclpy.clock import Clock, ClockType
-from swivel_car_control.ros_params import run_node
+from swivel_car_ros.ros_params import run_node
 from rclpy.node import Node
 from rclpy.time import Time
 from rcl_interfaces.msg import ParameterDescriptor
