@@ -54,6 +54,7 @@ class SimNode(Node):
         self._command_ready = False
         self._periods = 0
         self._period_start_wall = self._last_publish_wall = time.monotonic()
+        self._next_due_wall = self._period_start_wall  # [s] steady clock of the next paced advance
         self._messages = StateMessages(self.sim.joint_names)
 
         self._clock_pub = self.create_publisher(ClockMsg, '/clock', 10)
@@ -102,7 +103,12 @@ class SimNode(Node):
         self._command_ready = False
         self.sim.step(self.config.steps_per_period)
         self._periods += 1
-        self._period_start_wall = time.monotonic()
+        now = time.monotonic()
+        self._period_start_wall = now
+        # The pace keeps an absolute schedule, so the timer's lag does not add up period by
+        # period (it did: 0.67x at a pace of 1x); a sim more than a period behind restarts it.
+        due = self._next_due_wall + self._lockstep_min_wall
+        self._next_due_wall = due if due >= now - self._lockstep_min_wall else now
         self._publish_state()
 
     def _advance_if_running(self) -> None:
@@ -116,7 +122,7 @@ class SimNode(Node):
 
     def _advance_when_due(self) -> None:
         """Lockstep: advance on the awaited command, but not faster than the pace cap."""
-        if time.monotonic() - self._period_start_wall >= self._lockstep_min_wall:
+        if time.monotonic() >= self._next_due_wall:
             self._advance()
 
     def _on_lockstep_timer(self) -> None:
