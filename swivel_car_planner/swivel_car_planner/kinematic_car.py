@@ -2,8 +2,9 @@
 
 The model's planar kinematics (``planar.OffsetTricycleOdometry``) integrate the commanded
 swivel and drive; the swivel follows the rate-limited set point, exactly or ``sag`` short of
-it (as a PID under load), or not at all (``stuck``); pitch is the model's lift angle. No step
-and no physics: the sim is for those.
+it (as a PID under load), or not at all (``stuck``); pitch is the model's lift angle, plus,
+with a step placed (``place_step``), the pitch of the front axle on it while the rear axle is
+still below. No contact and no physics: the sim is for those.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from swivel_car_model import kinematics, planar
 from swivel_car_model.params import SwivelCarParams
 
 from swivel_car_planner.core import Command, Observation
+from swivel_car_planner.core.geometry import Pose2D, StepEdge
 
 DT = 0.01  # [s] control period
 DEFAULT_SWIVEL_RATE = 1.5  # [rad/s] the controller's, for commands with max_rate 0
@@ -38,6 +40,22 @@ class KinematicCar:
         self.sag = 0.0  # [rad] how far short of its set point the loaded swivel settles
         self.speed = 0.0  # [m/s] forward, as the drive makes it (no inertia)
         self.commands: list[Command] = []
+        self.step: StepEdge | None = None
+        self.step_pitch = 0.0  # [rad] nose up, the front axle on the step and the rear below
+
+    def place_step(self, height: float, distance: float, yaw: float = 0.0) -> None:
+        """A step as a climb request names it from the car's pose now. # [m], [rad]"""
+        pose = Pose2D(self.odometry.x, self.odometry.y, self.odometry.yaw)
+        self.step = StepEdge.from_request(pose, self.p.wheelbase, distance, yaw)
+        self.step_pitch = math.asin(min(1.0, height / self.p.wheelbase))
+
+    def _on_step_pitch(self) -> float:
+        if self.step is None:
+            return 0.0
+        pose = Pose2D(self.odometry.x, self.odometry.y, self.odometry.yaw)
+        front = self.step.signed_distance(*pose.transform(self.p.wheelbase, 0.0))
+        rear = self.step.signed_distance(*pose.transform(0.0, 0.0))
+        return -self.step_pitch if front > 0.0 > rear else 0.0
 
     def observe(self) -> Observation:
         """The car's state; the swivel torque is a stand-in, 10 N m/rad of swivel angle."""
@@ -45,7 +63,8 @@ class KinematicCar:
             time=self.time, x=self.odometry.x, y=self.odometry.y, yaw=self.odometry.yaw,
             swivel=self.swivel, swivel_rate=self.rate, set_point=self.set_point,
             torque=10.0 * self.swivel,
-            pitch=-float(kinematics.lift_angle(self.p, self.swivel)) + self.extra_pitch,
+            pitch=(-float(kinematics.lift_angle(self.p, self.swivel)) + self.extra_pitch
+                   + self._on_step_pitch()),
             roll=self.roll, imu_yaw=self.odometry.yaw + self.extra_yaw, speed=self.speed)
 
     def apply(self, command: Command) -> None:

@@ -12,12 +12,14 @@ from swivel_car_model.params import SwivelCarParams
 from swivel_car_planner.core import (
     ClimbRequest, ErrorCode, make_plan, PlanError, PlannerConfig, validate_request)
 from swivel_car_planner.core.plan import (
-    lead_angle, PROCEDURE_ACTIVE_LIFT, PROCEDURE_SEMI_ACTIVE)
+    lead_angle, lifted_lowest_point, PROCEDURE_ACTIVE_LIFT, PROCEDURE_SEMI_ACTIVE)
 
 P = SwivelCarParams()
 CONFIG = PlannerConfig()
 # make_plan without a whole-car limit checks the model's own limits only.
 FRONT = CONFIG
+# The standard lift wherever it can plan (the push-lift takes over from 24 cm by default).
+STANDARD = dataclasses.replace(CONFIG, push_lift_height=0.3)
 WHOLE_CAR_LIMIT = 0.08  # [m]
 
 
@@ -126,7 +128,7 @@ def drive_arc(plan, steps=2000):
 
 @pytest.mark.parametrize('height', [0.05, 0.15, 0.25, 0.26])
 def test_the_advance_arc_takes_the_lifted_wheel_over_the_edge_clear_of_the_other(height):
-    plan = make_plan(P, FRONT, request(height))
+    plan = make_plan(P, STANDARD, request(height))
     end_heading, lifted, other = drive_arc(plan)
     assert end_heading == pytest.approx(plan.lead_angle, abs=1e-6)
     start = -plan.lead_distance  # [m] the lifted wheel's contact to the edge at lift
@@ -143,13 +145,88 @@ def test_a_tight_advance_arc_is_planned_as_one():
     car 0.37 rad. The arc ends more oblique than the straight-line lead angle (the other
     wheel swings towards the riser on the way) and the approach leads with the other wheel.
     At 27 cm (1.37 rad, 0.28 m) no heading keeps the other wheel off the riser."""
-    plan = make_plan(P, FRONT, request(0.26))
+    plan = make_plan(P, STANDARD, request(0.26))
+    assert not plan.push_lift
     assert abs(plan.swivel_angle) <= P.swivel_limit
     assert abs(plan.lead_angle) > lead_angle(P, CONFIG, 0.26) + 0.1
     assert abs(plan.advance_turn) > 0.3
     assert plan.lifted_side * plan.approach_heading > 0.0
-    error = refusal(height=0.27)
-    assert error.code == ErrorCode.WHEEL_INTERFERENCE and 'riser' in error.message
+    assert make_plan(P, FRONT, request(0.27, distance=3.0)).push_lift
+
+
+def test_where_no_heading_keeps_the_other_wheel_off_the_riser_the_grounded_one_leads():
+    """The push-lift (docs/climbing_design.md, "The front wheels"): at 27 cm the approach
+    turns the other way, the grounded wheel stops push_gap short of the riser and the lifted
+    one trails it by 2 h sin(push_lead)."""
+    plan = make_plan(P, FRONT, request(0.27, distance=3.0))
+    assert plan.push_lift
+    assert plan.swivel_angle == pytest.approx(P.swivel_limit * plan.lifted_side)
+    assert plan.wheel_clearance > CONFIG.clearance_margin
+    lead = CONFIG.push_lead
+    assert plan.approach_heading == pytest.approx(plan.lifted_side * lead)
+    grounded = plan.lead_distance - 2.0 * P.h * math.sin(lead)  # [m] its rest contact
+    assert grounded == pytest.approx(
+        P.r * math.cos(lead) + P.wheel_width / 2.0 * math.sin(lead) + CONFIG.push_gap)
+    axle_normal = plan.approach_distance * math.cos(plan.approach_heading)
+    assert axle_normal == pytest.approx(plan.lead_distance - P.h * math.sin(lead))
+    _, _, drift_yaw = dynamics.swivel_pose_drift(P, 0.0, plan.swivel_angle)
+    assert plan.lead_angle == pytest.approx(
+        plan.approach_heading + drift_yaw + plan.advance_turn)
+
+
+def lowest_rim_point(centre, axle, samples=20000):
+    """Brute force: the lowest of ``samples`` points on a wheel's rim. # [m]"""
+    axle = axle / np.linalg.norm(axle)
+    u = np.cross(axle, [0.0, 0.0, 1.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(axle, u)
+    angles = np.linspace(0.0, 2.0 * math.pi, samples)
+    rim = centre + P.r * (np.outer(np.cos(angles), u) + np.outer(np.sin(angles), v))
+    return rim[np.argmin(rim[:, 2])]
+
+
+@pytest.mark.parametrize('swivel', [1.0, 1.37, -1.37])
+def test_the_lifted_wheels_lowest_point_is_where_its_rim_is_lowest(swivel):
+    frames = kinematics.forward_kinematics(P, swivel)
+    right, left = frames.o3[:3, 3], frames.o3_left[:3, 3]
+    lifted, grounded = (left, right) if swivel > 0 else (right, left)
+    low = lowest_rim_point(lifted, left - right)
+    ground = lowest_rim_point(grounded, left - right)
+    assert (low[0], low[1]) == pytest.approx(lifted_lowest_point(P, swivel), abs=1e-4)
+    assert low[2] - ground[2] == pytest.approx(
+        kinematics.lifted_wheel_lowest_height(P, swivel), abs=1e-4)
+    # Near the swivel limit the lifted wheel is ahead of the grounded wheel's contact.
+    if abs(swivel) > 1.3:
+        assert low[0] > float(kinematics.contact_point(P, swivel)[0]) + 0.08
+
+
+def test_the_push_advance_takes_the_lifted_wheel_over_before_the_grounded_one_meets_the_riser():
+    """Euler-integrate base_link on the arc from the lift, independently of the plan's
+    closed form: the lifted wheel's lowest point ends push_margin past the edge, the
+    grounded wheel's contact never passes the riser."""
+    plan = make_plan(P, FRONT, request(0.27, distance=3.0))
+    curvature = planar.curvature_for_swivel(P, plan.swivel_angle)
+    heading = plan.lead_angle - plan.advance_turn
+    steps = 2000
+    ds = plan.advance_length / steps
+    # base_link along the normal at the lift, from the lifted wheel's rest contact
+    x = (-plan.lead_distance - P.wheelbase * math.cos(plan.approach_heading)
+         + plan.lifted_side * P.h * math.sin(plan.approach_heading))
+    contact = [float(v) for v in kinematics.contact_point(P, plan.swivel_angle)]
+    lifted, grounded = [], []
+    for _ in range(steps + 1):
+        for (bx, by), out in ((plan.lifted_point, lifted), (contact, grounded)):
+            out.append(x + bx * math.cos(heading) - by * math.sin(heading))
+        x += ds * math.cos(heading + curvature * ds / 2.0)
+        heading += curvature * ds
+    assert lifted[-1] == pytest.approx(CONFIG.push_margin, abs=2e-3)
+    assert max(grounded) <= 0.0
+
+
+def test_a_push_lift_that_cannot_get_over_says_why():
+    error = refusal(config=dataclasses.replace(CONFIG, push_gap=0.3), height=0.27,
+                    distance=3.0)
+    assert error.code == ErrorCode.WHEEL_INTERFERENCE and 'push_lead' in error.message
 
 
 def test_a_step_beyond_the_swivel_limit_is_refused_with_it():
@@ -276,7 +353,8 @@ def test_every_plan_keeps_its_margins_or_says_why_not(height, yaw):
     assert plan.peak_torque <= P.swivel_torque_limit
     assert math.isfinite(plan.duration) and plan.duration > 0.0
     assert plan.lifted_side * plan.swivel_angle > 0.0
-    assert abs(plan.lead_angle) >= climbing.min_approach_angle_for_step(P, height) - 1e-12
+    if not plan.push_lift:  # the push-lift checks the wheels' positions at the lift angle
+        assert abs(plan.lead_angle) >= climbing.min_approach_angle_for_step(P, height) - 1e-12
 
 
 def test_negative_phi_plans_the_semi_active_procedure():

@@ -26,6 +26,14 @@ def start(height=0.04, distance=1.2, yaw=0.0, config=CONFIG, allowance=0.0):
     return ClimbStateMachine(P, config, plan, distance, yaw, allowance), plan
 
 
+def car_before(height=0.04, distance=1.2, yaw=0.0):
+    """A car with the step of ``start``'s request placed: it pitches while only its front
+    axle is on top."""
+    car = KinematicCar()
+    car.place_step(height, distance, yaw)
+    return car
+
+
 def run(machine, car, seconds=120.0, until=None):
     """Run until the outcome (or ``until(machine, car)``); returns the phases seen."""
     phases = []
@@ -41,7 +49,7 @@ def run(machine, car, seconds=120.0, until=None):
 @pytest.mark.parametrize('yaw', [0.0, 0.3, -0.4])
 def test_climb_goes_through_every_phase_and_ends_with_all_wheels_past_the_edge(yaw):
     machine, plan = start(yaw=yaw)
-    car = KinematicCar()
+    car = car_before(yaw=yaw)
     phases = run(machine, car)
     assert machine.outcome.success, machine.outcome.message
     assert phases == [Phase.APPROACH, Phase.LIFT, Phase.ADVANCE, Phase.SET_DOWN,
@@ -72,7 +80,7 @@ def test_a_step_too_close_to_turn_backs_up_straight_then_approaches():
 
 def test_the_climb_ends_only_once_the_car_stands_on_top():
     machine, _ = start()
-    car = KinematicCar()
+    car = car_before()
     run(machine, car, until=lambda m, c: m.step == Step.STOP_ON_TOP)
     assert machine.outcome is None
     assert car.commands[-1].drive_speed == 0.0 and car.commands[-1].hold
@@ -89,7 +97,7 @@ def test_a_car_still_tipping_when_its_wheels_stop_is_not_called_on_top():
     # stopped just as the rocking car passed level (roll 0.03 rad); the IMU then showed it
     # rolling on at 0.4 rad/s to 0.13 rad, where it came to rest on the corner.
     machine, _ = start()
-    car = KinematicCar()
+    car = car_before()
     run(machine, car, until=lambda m, c: m.step == Step.STOP_ON_TOP)
     stopped = None
     while machine.outcome is None and car.time < 120.0:
@@ -101,6 +109,16 @@ def test_a_car_still_tipping_when_its_wheels_stop_is_not_called_on_top():
     assert_safe_abort(machine, car, ErrorCode.FAILED)
     assert 'rolled 0.130 rad' in machine.outcome.message
     assert 'not on top' in machine.outcome.message
+
+
+def test_wheels_spinning_against_the_riser_are_not_a_climb():
+    # Measured (24-26 cm, the front never up): the car stayed level while odometry counted
+    # the spinning wheels as travel past the edge; it was called "climbed".
+    machine, _ = start()
+    car = KinematicCar()  # no step: level all the way
+    run(machine, car)
+    assert_safe_abort(machine, car, ErrorCode.FAILED)
+    assert 'front wheels never got on top' in machine.outcome.message
 
 
 def test_lift_starts_at_the_planned_distance_and_heading():
@@ -128,9 +146,35 @@ def test_lifted_wheel_is_over_the_edge_when_it_is_set_down():
     assert car.swivel == pytest.approx(plan.swivel_angle, abs=CONFIG.swivel_tolerance)
 
 
+def test_a_push_lift_leads_with_the_grounded_wheel_and_drives_while_it_sets_down():
+    machine, plan = start(height=0.27, distance=2.0)
+    assert plan.push_lift
+    car = KinematicCar()
+    edge = StepEdge.from_request(Pose2D(0.0, 0.0, 0.0), P.wheelbase, 2.0, 0.0)
+
+    def past_edge(bx, by):
+        pose = Pose2D(car.odometry.x, car.odometry.y, car.odometry.yaw)
+        return edge.signed_distance(*pose.transform(bx, by))
+
+    run(machine, car, until=lambda m, c: m.phase == Phase.LIFT)
+    lifted = past_edge(P.wheelbase, plan.lifted_side * P.h)
+    assert lifted == pytest.approx(-plan.lead_distance, abs=0.01)
+    assert past_edge(P.wheelbase, -plan.lifted_side * P.h) > lifted + 0.1  # grounded leads
+    run(machine, car, until=lambda m, c: m.phase == Phase.SET_DOWN)
+    assert CONFIG.push_margin <= past_edge(*plan.lifted_point) < CONFIG.push_margin + 0.01
+    first = len(car.commands)
+    run(machine, car, until=lambda m, c: m.step != Step.SET_DOWN)
+    set_down = car.commands[first:-1]
+    assert set_down and all(c.drive_speed == CONFIG.set_down_speed for c in set_down)
+    angles = [plan.swivel_angle] + [c.angle for c in set_down]
+    steps = [plan.lifted_side * (b - a) for a, b in zip(angles, angles[1:])]
+    assert all(-CONFIG.swivel_rate * 0.01 - 1e-9 <= s <= 1e-9 for s in steps)  # a ramp
+    assert machine.outcome is None
+
+
 def test_outer_loop_reaches_the_wanted_angles_when_the_swivel_sags_under_load():
     machine, plan = start()
-    car = KinematicCar()
+    car = car_before()
     car.sag = 0.15
     run(machine, car, until=lambda m, c: m.phase == Phase.ADVANCE)
     assert car.swivel == pytest.approx(plan.swivel_angle, abs=CONFIG.swivel_tolerance)
@@ -151,7 +195,7 @@ def test_rear_axle_that_does_not_climb_ends_failed_and_stopped():
 
 def test_the_rear_axle_climbs_with_the_swivel_free_and_stops_held():
     machine, _ = start()
-    car = KinematicCar()
+    car = car_before()
     run(machine, car, until=lambda m, c: m.step == Step.REAR)
     run(machine, car, until=lambda m, c: m.step != Step.REAR)
     rear = [c for c in car.commands if c.free]
@@ -276,7 +320,7 @@ def test_nose_down_pitch_is_no_tip_over():
 
 def test_heading_comes_from_the_imu():
     machine, plan = start(yaw=0.2)
-    car = KinematicCar()
+    car = car_before(yaw=0.2)
     car.extra_yaw = 0.3  # at the start: only an offset between the two headings
     run(machine, car, until=lambda m, c: m.phase == Phase.LIFT)
     car.odometry.set_pose(car.odometry.x, car.odometry.y, car.odometry.yaw + 0.2)
@@ -318,6 +362,7 @@ def test_a_car_asked_while_moving_first_stops_holding_its_swivel():
     for _ in range(50):
         car.apply(Command(0.2, 0.0, 4.0, True))
     assert car.speed > 0.2
+    car.place_step(0.04, 1.2)
     machine, plan = start()
     first = machine.update(car.observe())
     assert machine.step == Step.STOP and machine.phase == Phase.APPROACH

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+from swivel_car_model.checks import check_finite_number
 from swivel_car_model.description import described
 
 
@@ -33,6 +34,22 @@ class PlannerConfig:
         0.03, 'lifted wheel past the edge while the other front wheel is still clear [m]')
     lift_gap: float = described(0.03, 'lifted wheel front to the riser when the lift starts [m]')
     max_lead_angle: float = described(0.8, 'largest approach angle to the step normal [rad]')
+    push_lift_height: float = described(
+        0.24, 'steps at least this high use the push-lift; lower ones too where no '
+        'approach heading lets the lifted wheel lead (WHEEL_INTERFERENCE) [m]')
+    push_lead: float = described(
+        0.6, 'push-lift (steps no standard approach can lift onto, WHEEL_INTERFERENCE): '
+        'heading to the step normal at the lift, turned so the grounded front wheel leads '
+        '[rad]')
+    push_gap: float = described(
+        0.03, 'push-lift: the grounded front wheel\'s front to the riser when the lift starts '
+        '[m]')
+    push_margin: float = described(
+        0.05, 'push-lift: the advance ends with the point where the lifted wheel will land '
+        'this far past the edge [m]')
+    set_down_speed: float = described(
+        1.0, 'push-lift: drive speed at the wheels while the swivel sets the lifted wheel '
+        'down (the rear axle follows the front as it pitches up) [rad/s]')
     approach_speed: float = described(3.0, 'drive speed at the wheels while approaching [rad/s]')
     climb_speed: float = described(2.0, 'drive speed at the wheels while climbing [rad/s]')
     rear_speed: float = described(
@@ -86,12 +103,10 @@ class PlannerConfig:
     def __post_init__(self) -> None:
         for item in fields(self):
             value = getattr(self, item.name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                    or not math.isfinite(value):
-                raise ValueError(f'{item.name} must be a finite number, got {value!r}')
+            check_finite_number(item.name, value)
             if value < 0.0:
                 raise ValueError(f'{item.name} must be >= 0, got {value!r}')
-        for name in ('max_step_distance', 'max_step_yaw', 'max_lead_angle',
+        for name in ('max_step_distance', 'max_step_yaw', 'max_lead_angle', 'push_lead',
                      'approach_speed', 'climb_speed', 'rear_speed', 'swivel_rate', 'max_steer',
                      'swivel_tolerance', 'settle_rate', 'stop_speed',
                      'stall_progress',
@@ -99,6 +114,6 @@ class PlannerConfig:
                      'time_allowance'):
             if getattr(self, name) <= 0.0:
                 raise ValueError(f'{name} must be > 0, got {getattr(self, name)!r}')
-        for name in ('max_step_yaw', 'max_lead_angle'):
+        for name in ('max_step_yaw', 'max_lead_angle', 'push_lead'):
             if getattr(self, name) >= math.pi / 2:
                 raise ValueError(f'{name} must be below pi/2, got {getattr(self, name)!r}')

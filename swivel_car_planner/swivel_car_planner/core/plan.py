@@ -44,6 +44,22 @@ Lifting the wheel turns and shifts the car (thesis II.E; ``dynamics.swivel_pose_
 approach aims at ``psi_lead - advance_turn - drift_yaw`` so that the car starts the arc at the
 planned heading once the wheel is up, and starts the lift far enough back that the drift does
 not push the rising wheel into the riser.
+
+Push-lift
+---------
+Where no such heading exists (``WHEEL_INTERFERENCE`` above, 27 cm on the default robot), and
+for every step from ``push_lift_height`` up, the plan turns the other way: the *grounded*
+front wheel leads, at ``push_lead`` to the normal, stops ``push_gap`` short of the riser, and
+the swivel lifts to its limit whatever the step needs. Near that limit the front wheels no
+longer sit where they rest: the grounded wheel's contact moves back and in towards the centre
+line (``kinematics.contact_point``) and the lifted wheel rises forward over it (the shaft
+turns about the inclined column), so the lifted wheel's lowest point ends 9 cm ahead of the
+grounded wheel's contact at 1.4 rad (less at lower angles: in the sim 1.3 rad left it short),
+and the lift's yaw turns it further towards the edge. The advance on the arc then carries the
+point where the lifted wheel will land (``landing_point``) ``push_margin`` over the edge
+while the grounded wheel's contact stays short of the riser, and the set-down drives at
+``set_down_speed``: the car pitches up about the rear axle as the wheel takes the load, and
+with the wheels held the wheel on the top slid back off the edge (measured in the sim).
 """
 
 from __future__ import annotations
@@ -109,6 +125,10 @@ class ClimbPlan:
     # docstring); ``lead_angle - advance_turn`` is the heading once the wheel is up
     advance_turn: float = 0.0
     advance_length: float = 0.0  # [m] base_link's path along that arc
+    # The push-lift (module docstring): the grounded wheel leads, the advance ends on the
+    # point where the lifted wheel will land on the step, ``lifted_point`` in base_link
+    push_lift: bool = False
+    lifted_point: tuple[float, float] = (0.0, 0.0)  # [m]
 
 
 def lead_angle(p: SwivelCarParams, config: PlannerConfig, step_height: float) -> float:
@@ -220,6 +240,69 @@ def advance_arc(p: SwivelCarParams, config: PlannerConfig, swivel: float, side: 
                     f'wheel get over the edge with the other front wheel clear of the riser')
 
 
+def lifted_lowest_point(p: SwivelCarParams, swivel: float) -> tuple[float, float]:
+    """The lifted front wheel's lowest rim point in base_link (level) at ``swivel`` (model):
+    both wheels share the shaft, so it lies from the lifted wheel's centre as the grounded
+    wheel's contact lies from its own. # [m]"""
+    frames = kinematics.forward_kinematics(p, swivel)
+    right, left = frames.o3[:2, 3], frames.o3_left[:2, 3]
+    lifted, grounded = (left, right) if swivel > 0.0 else (right, left)
+    contact = np.array([float(v) for v in kinematics.contact_point(p, swivel)])
+    x, y = lifted + contact - grounded
+    return float(x), float(y)
+
+
+def landing_point(p: SwivelCarParams, height: float, side: int) -> tuple[float, float]:
+    """Where in base_link (level) the lifted wheel on ``side`` touches a step of ``height``
+    as the swivel sets it down: its lowest point at the swivel that puts it at that height
+    (it moves back as the swivel comes down from the lift). # [m]"""
+    swivel = float(kinematics.swivel_for_step(p, height, respect_tip_over=False))
+    return lifted_lowest_point(p, side * swivel)
+
+
+def push_advance(p: SwivelCarParams, config: PlannerConfig, swivel: float, side: int,
+                 lead_distance: float, drift_yaw: float, height: float) -> AdvanceArc:
+    """The push-lift's advance on the arc of the held ``swivel`` (module docstring): from the
+    heading ``side * push_lead`` at lift, turned by the lift's ``drift_yaw``, until the point
+    where the wheel will land on a step of ``height`` is ``push_margin`` past the edge, the
+    lifted wheel's rest contact ``lead_distance`` short of it when the lift starts. # [rad], [m]
+
+    Raises
+    ------
+    PlanError
+        ``WHEEL_INTERFERENCE``: the grounded wheel's contact would reach the riser first, or
+        the arc turns the lifted wheel away before it is over.
+    """
+    lift_heading = side * config.push_lead  # [rad]
+    start = lift_heading + drift_yaw  # [rad] once the wheel is up
+    curvature = float(planar.curvature_for_swivel(p, swivel))  # [1/m]
+    base = (-lead_distance - p.wheelbase * math.cos(lift_heading)
+            + side * p.h * math.sin(lift_heading))  # [m] base_link along the normal
+    longest = min(2.0, math.pi / abs(curvature)) if curvature != 0.0 else 2.0  # [m]
+    lengths = np.linspace(0.0, longest, _ARC_SAMPLES)
+    headings = start + curvature * lengths
+    if curvature == 0.0:
+        travel = lengths * math.cos(start)
+    else:
+        travel = (np.sin(headings) - math.sin(start)) / curvature
+
+    def normal(point: tuple[float, float]) -> np.ndarray:
+        return (base + travel + point[0] * np.cos(headings)
+                - point[1] * np.sin(headings))
+
+    lifted = normal(landing_point(p, height, side))
+    grounded = normal(tuple(float(v) for v in kinematics.contact_point(p, swivel)))
+    over = np.nonzero(lifted >= config.push_margin)[0]
+    if over.size == 0 or np.max(grounded[:over[0] + 1]) > 0.0:
+        raise PlanError(ErrorCode.WHEEL_INTERFERENCE,
+                        f'with the grounded front wheel leading at {config.push_lead:.2f} rad '
+                        f'(push_lead) and the swivel held at {swivel:.2f} rad, the lifted '
+                        f'wheel does not get {config.push_margin:.3f} m over the edge before '
+                        f'the grounded wheel meets the riser or the arc turns it away')
+    k = int(over[0])
+    return AdvanceArc(float(headings[k]), float(headings[k] - start), float(lengths[k]))
+
+
 @dataclass(frozen=True)
 class _Approach:
     """How the car meets the edge when it lifts the wheel on ``side``."""
@@ -255,8 +338,40 @@ def _approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
         heading = advance.end_heading - advance.turn - drift_yaw
         drift_normal = drift_x * math.cos(heading) - drift_y * math.sin(heading)
         lead_distance = p.r + config.lift_gap + max(0.0, drift_normal)
+    return _placed(p, config, request, side, advance, heading, lead_distance,
+                   lead_distance + p.h * abs(math.sin(heading)))
+
+
+def _push_approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
+                   theta2: float, side: int) -> _Approach:
+    """The push-lift's approach (module docstring): the grounded wheel leads at
+    ``push_lead`` and stops ``push_gap`` short of the riser; the swivel lifts to ``theta2``.
+    """
+    swivel = side * abs(theta2)
+    heading = side * config.push_lead
+    reach = math.sqrt(p.r ** 2 - (p.r - min(request.step_height, p.r)) ** 2)  # [m]
+    # The grounded wheel's rest contact when its front meets the riser, then the lifted one's.
+    touch = reach * math.cos(config.push_lead) + p.wheel_width / 2.0 * math.sin(
+        config.push_lead)  # [m]
+    lead_distance = touch + config.push_gap + 2.0 * p.h * math.sin(config.push_lead)
+    drift_yaw = float(dynamics.swivel_pose_drift(p, 0.0, swivel)[2])
+    advance = push_advance(p, config, swivel, side, lead_distance, drift_yaw,
+                           request.step_height)
+    # The lifted wheel trails: the axle's centre is nearer the edge than it.
+    return _placed(p, config, request, side, advance, heading, lead_distance,
+                   lead_distance - p.h * math.sin(config.push_lead), turn_first=True)
+
+
+def _placed(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest, side: int,
+            advance: AdvanceArc, heading: float, lead_distance: float,
+            axle_normal: float, turn_first: bool = False) -> _Approach:
+    """The approach that lifts at ``heading``, the lifted wheel's rest contact
+    ``lead_distance`` and the front axle's centre ``axle_normal`` short of the edge, then
+    advances on ``advance``: whether there is room to align, and where it crosses the
+    edge. ``turn_first``: aim at the crossing the car reaches by turning onto ``heading`` at
+    once on its tightest arc (the push-lift's large heading; a crossing that assumes an
+    instant turn leaves the car chasing its line at the lift point)."""
     psi_lead = advance.end_heading
-    axle_normal = lead_distance + p.h * abs(math.sin(heading))
 
     # Aligning turns on an arc of radius >= wheelbase / tan(max_steer); give it room.
     turn_radius = p.wheelbase / math.tan(config.max_steer)  # [m]
@@ -276,14 +391,15 @@ def _approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
         back = p.wheelbase + request.step_distance  # [m] base_link to the edge along x
         along, normal = back * math.sin(request.step_yaw), back * math.cos(request.step_yaw)
         initial = -request.step_yaw  # [rad] heading to the normal now
-        now = along + normal * math.tan(heading)
         # Late: straight on, one arc of radius turn_radius to the approach heading, then
         # straight at it from the lift point (base_link ``final`` before the edge) on.
         arc = turn_radius * abs(math.sin(heading) - math.sin(initial))  # [m] along normal
+        swing = math.copysign(turn_radius * abs(math.cos(initial) - math.cos(heading)),
+                              heading - initial)  # [m] the arc along the edge
+        now = (along + swing + (normal - arc) * math.tan(heading) if turn_first
+               else along + normal * math.tan(heading))
         final = axle_normal + p.wheelbase * math.cos(heading)  # [m]
-        late = (along + max(0.0, normal - arc - final) * math.tan(initial)
-                + math.copysign(turn_radius * abs(math.cos(initial) - math.cos(heading)),
-                                heading - initial)
+        late = (along + max(0.0, normal - arc - final) * math.tan(initial) + swing
                 + min(normal, final) * math.tan(heading))
         reachable = (min(now, late), max(now, late))
         crossing = min(high, max(low, now))
@@ -344,19 +460,7 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
                         f'the front wheels could lift over {height:.3f} m, but the whole car '
                         f'climbs reliably only up to {whole_car_limit:.3f} m (the rear axle '
                         f'climbs by traction; measured in the sim, the capability table)')
-    theta1 = float(kinematics.lift_angle(p, theta2))
-    tip_margin = float(kinematics.tip_over_margin(p, theta1))
-    if tip_margin < config.tip_over_margin:
-        raise PlanError(ErrorCode.TIP_OVER,
-                        f'lifting the wheel over {height:.3f} m pitches the car to '
-                        f'{theta1:.3f} rad, {tip_margin:.3f} rad from tipping over '
-                        f'(eq. 72); the planner wants {config.tip_over_margin:.3f} rad; the '
-                        f'largest step that keeps the rule is {max_step:.3f} m')
-    interference = float(kinematics.interference_margin(p, theta1))
-    if interference <= 0.0:
-        raise PlanError(ErrorCode.WHEEL_INTERFERENCE,
-                        f'at the lift angle {theta1:.3f} rad the front wheel shaft reaches the '
-                        f'rear wheels (eq. 75 margin {interference:.3f} m)')
+    theta1, tip_margin, interference = _lift_rules(p, config, height, theta2)
     peak_torque, energy = (float(v) for v in dynamics.climb_torque_energy(
         p, height, config.swivel_rate))
     if peak_torque > p.swivel_torque_limit:
@@ -364,20 +468,25 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
                         f'the climb needs a peak swivel torque of {peak_torque:.2f} N m, above '
                         f'the actuator limit of {p.swivel_torque_limit:.2f} N m')
 
-    # Lift the wheel on the side that leads already, so the car turns the least; with the
-    # step's extent known, on the side whose natural crossing of the edge lies nearer the
-    # top face.
     initial_heading = -request.step_yaw  # [rad] car heading to the edge's normal
     leading = 1 if initial_heading <= 0.0 else -1
-    sides = (leading, -leading) if request.step_width > 0.0 else (leading,)
     # Too close to turn onto the approach (or onto the crossing): backing up straight along
     # the car's x axis gives the same request with the edge further ahead.
     requested = request
+    push = height >= config.push_lift_height
     for backup in _backups(config.max_backup):
         request = dataclasses.replace(requested, step_distance=requested.step_distance + backup)
-        approaches = [_approach(p, config, request, theta2, side) for side in sides]
+        try:
+            approaches = _approaches(p, config, request, theta2, leading, push)
+        except PlanError as error:
+            # No heading keeps the other wheel off the riser: the push-lift leads with it.
+            if push or error.code != ErrorCode.WHEEL_INTERFERENCE:
+                raise
+            push = True
+            approaches = _approaches(p, config, request, theta2, leading, push)
+        preferred = approaches[0].side
         approach = min(approaches,
-                       key=lambda a: (a.error is not None, a.shift, a.side != leading))
+                       key=lambda a: (a.error is not None, a.shift, a.side != preferred))
         if approach.error is None:
             break
         if backup == 0.0:
@@ -387,6 +496,9 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
                         first_error if config.max_backup == 0.0 else
                         f'{first_error}; backing up {config.max_backup:.2f} m (max_backup) '
                         f'does not make room either: then {approach.error}')
+    if push:  # it lifts the wheel as high as the swivel goes (module docstring)
+        theta2 = p.swivel_limit
+        theta1, tip_margin, interference = _lift_rules(p, config, height, theta2)
     available = request.step_distance * math.cos(request.step_yaw)
     side, psi_lead, approach_heading = approach.side, approach.lead, approach.heading
     lead_distance, axle_normal = approach.lead_distance, approach.axle_normal
@@ -412,7 +524,47 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
         second_swivel_angle=-side * float(kinematics.swivel_for_step(
             p, config.clearance_margin, respect_tip_over=False)),
         step_height=height, crossing=approach.crossing, backup_distance=backup,
-        advance_turn=approach.arc.turn, advance_length=approach.arc.length)
+        advance_turn=approach.arc.turn, advance_length=approach.arc.length, push_lift=push,
+        lifted_point=landing_point(p, height, side) if push else (0.0, 0.0))
+
+
+def _lift_rules(p: SwivelCarParams, config: PlannerConfig, height: float,
+                theta2: float) -> tuple[float, float, float]:
+    """The lift angle [rad] at the swivel ``theta2`` [rad] and its margins on the tip-over
+    rule [rad] and the wheel interference rule [m].
+
+    Raises
+    ------
+    PlanError
+        ``TIP_OVER`` or ``WHEEL_INTERFERENCE`` when a margin is short.
+    """
+    theta1 = float(kinematics.lift_angle(p, theta2))
+    tip_margin = float(kinematics.tip_over_margin(p, theta1))
+    if tip_margin < config.tip_over_margin:
+        max_step, _ = kinematics.max_scalable_step(p, respect_tip_over=True)
+        raise PlanError(ErrorCode.TIP_OVER,
+                        f'lifting the wheel over {height:.3f} m pitches the car to '
+                        f'{theta1:.3f} rad, {tip_margin:.3f} rad from tipping over '
+                        f'(eq. 72); the planner wants {config.tip_over_margin:.3f} rad; the '
+                        f'largest step that keeps the rule is {max_step:.3f} m')
+    interference = float(kinematics.interference_margin(p, theta1))
+    if interference <= 0.0:
+        raise PlanError(ErrorCode.WHEEL_INTERFERENCE,
+                        f'at the lift angle {theta1:.3f} rad the front wheel shaft reaches the '
+                        f'rear wheels (eq. 75 margin {interference:.3f} m)')
+    return theta1, tip_margin, interference
+
+
+def _approaches(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
+                theta2: float, leading: int, push: bool) -> list[_Approach]:
+    """The approaches to choose from, the one that turns the car the least first: the
+    standard lift lifts the wheel that leads already (``leading``), the push-lift the other
+    one. With the step's extent known, both sides: the one whose crossing of the edge lies
+    nearer the top face may win."""
+    preferred = -leading if push else leading
+    sides = (preferred, -preferred) if request.step_width > 0.0 else (preferred,)
+    make, lift = (_push_approach, p.swivel_limit) if push else (_approach, theta2)
+    return [make(p, config, request, lift, side) for side in sides]
 
 
 _BACKUP_INCREMENT = 0.05  # [m]

@@ -26,6 +26,13 @@ action phase each one reports)::
                      the car stands and the IMU's pitch and roll have been
                      still for ``settle_time``; done if it is still level       CLIMB_REST
 
+A push-lift plan (``plan.push_lift``: the grounded wheel leads to the riser, plan module)
+changes two steps: ADVANCE ends with the point where the lifted wheel will land on the step
+(``plan.lifted_point``) ``push_margin`` past the edge, and SET_DOWN drives at
+``set_down_speed`` while it ramps its command at ``swivel_rate`` (the controller drives at
+full speed only while its swivel error is below ``slowdown_start``), so that the rear axle
+follows the front as it pitches up instead of the wheel on the top sliding back off the edge.
+
 Every step but APPROACH wants the *measured* swivel at an angle. Under load (a wheel lifted,
 or the front of the car lifted with one wheel on the step) the controller's PID settles short
 of its set point (measured in the sim: up to 0.3 rad with the thesis gains and an integral
@@ -196,6 +203,7 @@ class ClimbStateMachine:
         self._cancel_requested = False
         self._hold_angle = 0.0  # [rad] swivel held after a failure
         self._bias = 0.0  # [rad] outer-loop correction added to the wanted swivel angle
+        self._ramp_start = (0.0, 0.0)  # (time [s], swivel [rad]) when the step began
         self._last_command = 0.0  # [rad] swivel angle last sent
         self.outcome: Outcome | None = None
         self.feedback = Feedback(Phase.PLANNING, 'PLANNING', 0.0, 0.0, 0.0, 0.0, 0.0,
@@ -269,7 +277,7 @@ class ClimbStateMachine:
                 return self._enter(Step.ADVANCE, obs)
             return self._hold(obs, plan.swivel_angle, 0.0)
         if step == Step.ADVANCE:
-            if self._lifted_wheel_distance(obs) >= config.lead_margin:
+            if self._advance_distance(obs) >= self._advance_goal():
                 return self._enter(Step.SET_DOWN, obs)
             return self._hold(obs, plan.swivel_angle, config.climb_speed)
         if step == Step.SET_DOWN:
@@ -277,6 +285,8 @@ class ClimbStateMachine:
             # clearance_margin up: the swivel at or beyond plan.second_swivel_angle.
             if side * obs.swivel <= side * plan.second_swivel_angle + config.swivel_tolerance:
                 return self._enter(Step.SECOND_ADVANCE, obs)
+            if plan.push_lift:
+                return self._ramp(obs, plan.second_swivel_angle, config.set_down_speed)
             return self._hold(obs, plan.second_swivel_angle, 0.0)
         if step == Step.SECOND_ADVANCE:
             if self._second_wheel_distance(obs) >= config.lead_margin:
@@ -316,6 +326,13 @@ class ClimbStateMachine:
                 obs, ErrorCode.FAILED,
                 f'the front wheels came down off the step while the rear axle was still '
                 f'{-rear:.2f} m short of the edge')
+        if rear >= config.rest_margin and level and not self._front_seen_up:
+            # Odometry counts wheels spinning against the riser as travel: level all along,
+            # the front never got up (seen at 24-26 cm, once called "climbed").
+            return self._finish(
+                obs, ErrorCode.FAILED,
+                f'the front wheels never got on top: the car stayed level while odometry put '
+                f'the rear axle {rear:.2f} m past the edge (the wheels spun against the riser)')
         if rear >= config.rest_margin and level:
             # The rear wheels leave the riser at speed: stop on the top face before calling
             # it done, the swivel held so the car neither turns nor twists a wheel up.
@@ -392,6 +409,10 @@ class ClimbStateMachine:
         off_line = -math.sin(heading) * normal + math.cos(heading) * along  # [m] left of it
         correction = self._config.crossing_gain * off_line
         limit = self._config.max_steer
+        if plan.push_lift:
+            # Its heading is large: far off the line the car may hold the heading it has
+            # and meet the line at an angle, rather than chase it at max_steer to the lift.
+            limit = max(limit, abs(heading))
         return heading - min(limit, max(-limit, correction))
 
     def _steer(self, obs: Observation, heading: float, drive_speed: float) -> Command:
@@ -408,6 +429,18 @@ class ClimbStateMachine:
         self._goal_error = None
         self._last_command = angle
         return Command(angle, self._config.swivel_rate, drive_speed, True, free)
+
+    def _ramp(self, obs: Observation, angle: float, drive_speed: float) -> Command:
+        """Command a ramp at ``swivel_rate`` from the swivel where the step began towards
+        ``angle`` while driving at ``drive_speed``: the set point and the command stay
+        together, so the controller keeps driving. No outer loop; the stall monitor watches
+        the measured swivel's headway on ``angle``."""
+        since, start = self._ramp_start
+        travel = self._config.swivel_rate * (obs.time - since)  # [rad]
+        ramped = start + math.copysign(min(abs(angle - start), travel), angle - start)
+        command = self._open_loop(ramped, drive_speed)
+        self._goal_error = abs(angle - obs.swivel)
+        return command
 
     def _hold(self, obs: Observation, angle: float, drive_speed: float) -> Command:
         """Bring the measured swivel to ``angle`` (outer loop, see the module docstring)
@@ -448,13 +481,15 @@ class ClimbStateMachine:
         self._progress_ref = (obs.time, self._path)
         self._at_rest_since = None
         self._stall_ref = (obs.time, math.inf)
+        limit = self._p.swivel_limit
+        self._ramp_start = (obs.time, min(limit, max(-limit, obs.swivel)))
         plan, config = self._plan, self._config
         spans = {
             Step.STOP: (abs(obs.speed), 0.0),
             Step.BACK_UP: (self._backed_up(obs), plan.backup_distance),
             Step.APPROACH: (self._lifted_wheel_distance(obs), -plan.lead_distance),
             Step.LIFT: (obs.swivel, plan.swivel_angle),
-            Step.ADVANCE: (self._lifted_wheel_distance(obs), config.lead_margin),
+            Step.ADVANCE: (self._advance_distance(obs), self._advance_goal()),
             Step.SET_DOWN: (obs.swivel, plan.second_swivel_angle),
             Step.SECOND_ADVANCE: (self._second_wheel_distance(obs), config.lead_margin),
             Step.SECOND_SET_DOWN: (obs.swivel, 0.0),
@@ -481,6 +516,19 @@ class ClimbStateMachine:
     def _lifted_wheel_distance(self, obs: Observation) -> float:
         return self._wheel_distance(obs, self._p.wheelbase, self._plan.lifted_side * self._p.h)
 
+    def _advance_distance(self, obs: Observation) -> float:
+        """What ADVANCE drives until it reaches ``_advance_goal``: the lifted wheel's rest
+        contact past the edge, or for a push-lift the point where it will land. # [m]
+        """
+        if self._plan.push_lift:
+            return self._wheel_distance(obs, *self._plan.lifted_point)
+        return self._lifted_wheel_distance(obs)
+
+    def _advance_goal(self) -> float:
+        """# [m] see ``_advance_distance``"""
+        config = self._config
+        return config.push_margin if self._plan.push_lift else config.lead_margin
+
     def _second_wheel_distance(self, obs: Observation) -> float:
         return self._wheel_distance(obs, self._p.wheelbase, -self._plan.lifted_side * self._p.h)
 
@@ -494,8 +542,10 @@ class ClimbStateMachine:
             return abs(obs.speed)
         if self._step == Step.BACK_UP:
             return self._backed_up(obs)
-        if self._step in (Step.APPROACH, Step.ADVANCE):
+        if self._step == Step.APPROACH:
             return self._lifted_wheel_distance(obs)
+        if self._step == Step.ADVANCE:
+            return self._advance_distance(obs)
         if self._step == Step.SECOND_ADVANCE:
             return self._second_wheel_distance(obs)
         if self._step == Step.REAR:
