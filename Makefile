@@ -41,6 +41,8 @@ bench: build
 	$(IN_WS) python -m swivel_car_model.benchmark
 	$(IN_WS) python -m swivel_car_sim.benchmark
 	$(IN_WS) python -m swivel_car_control.benchmark
+	$(IN_WS) python -m swivel_car_bringup.benchmark
+	$(IN_WS) python -m swivel_car_bringup.campaign_benchmark
 	$(IN_WS) python -m swivel_car_bringup.climb_benchmark $(CLIMB_BENCH_ARGS)
 
 # Ten minutes of driving and climbs through the ROS stack: memory slope and message rates.

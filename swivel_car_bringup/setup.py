@@ -12,6 +12,7 @@ setup(
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml', 'README.md']),
         ('share/' + package_name + '/launch', glob('launch/*.launch.py')),
+        ('share/' + package_name + '/config/campaigns', glob('config/campaigns/*.yaml')),
     ],
     install_requires=['setuptools'],
     zip_safe=True,
@@ -25,6 +26,7 @@ setup(
             'recorder_node = swivel_car_bringup.recorder_node:main',
             'robot_description_node = swivel_car_bringup.robot_description_node:main',
             'foxglove_bridge_node = swivel_car_bringup.foxglove_bridge_node:main',
+            'campaign = swivel_car_bringup.campaign:main',
         ],
     },
 )

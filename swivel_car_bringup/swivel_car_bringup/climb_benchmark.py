@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import argparse
 from collections import defaultdict
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 import math
 from pathlib import Path
 import random
@@ -33,6 +33,7 @@ import numpy as np
 import yaml
 
 from swivel_car_model import kinematics, traction
+from swivel_car_model.checks import check_finite_number
 from swivel_car_model.description import CarDescription
 from swivel_car_planner.core import ClimbRequest, ErrorCode
 from swivel_car_planner.core.capability import CapabilityTable, description_values, RELIABLE
@@ -66,6 +67,50 @@ class Trial:
     rear_sign_changes: int  # swivel torque sign changes while the rear axle climbs
     rear_peak_torque: float  # [N m] while the rear axle climbs
     backup: float  # [m] the car backed up first this far
+    success: bool  # the planner's verdict
+    duration: float  # [s] sim time of the climb, 0 when refused
+
+
+@dataclass(frozen=True)
+class RequestRanges:
+    """Where randomised climb requests are drawn from (uniformly).
+
+    Raises
+    ------
+    ValueError
+        A bound that is not a finite number, a minimum above its maximum, or no width (the
+        sim's step needs a top face); the message names it.
+    """
+
+    min_distance: float = 0.2  # [m] front axle to the edge
+    max_distance: float = 1.0  # [m]
+    max_yaw: float = 0.3  # [rad] the edge's yaw, within +-this
+    min_width: float = 0.8  # [m] the top face along the edge
+    max_width: float = 2.0  # [m]
+    max_offset: float = 0.0  # [m] the face centre along the edge, within +-this
+
+    def __post_init__(self) -> None:
+        for item in fields(self):
+            value = getattr(self, item.name)
+            check_finite_number(item.name, value)
+        if self.min_width <= 0.0:
+            raise ValueError(f'min_width must be > 0, got {self.min_width!r}')
+        for low, high in (('min_distance', 'max_distance'), ('min_width', 'max_width')):
+            if getattr(self, low) > getattr(self, high):
+                raise ValueError(f'{low} must be <= {high}, got {getattr(self, low)!r} > '
+                                 f'{getattr(self, high)!r}')
+
+    def draw(self, rng: random.Random) -> tuple[float, float, float, float]:
+        """distance [m], yaw [rad], width [m], offset [m] of one request."""
+        return (rng.uniform(self.min_distance, self.max_distance),
+                rng.uniform(-self.max_yaw, self.max_yaw),
+                rng.uniform(self.min_width, self.max_width),
+                rng.uniform(-self.max_offset, self.max_offset))
+
+    def bounds(self) -> tuple[tuple[float, float, float, float], ...]:
+        """The lowest and the highest (distance, yaw, width, offset) ``draw`` returns."""
+        return ((self.min_distance, -self.max_yaw, self.min_width, -self.max_offset),
+                (self.max_distance, self.max_yaw, self.max_width, self.max_offset))
 
 
 def heights(start: float, stop: float, step: float) -> list[float]:
@@ -79,7 +124,41 @@ def sign_changes(torque: np.ndarray, threshold: float = _CHATTER_TORQUE) -> int:
     return int(np.count_nonzero(signs[1:] != signs[:-1]))
 
 
-def run_swivel(args: argparse.Namespace, config: StackConfig,
+def climb_trial(stack: InProcessStack, height: float, distance: float, yaw: float,
+                width: float, offset: float) -> Trial:
+    """One climb from where ``stack`` stands: the car settles, a step appears ahead, the
+    planner climbs it, the car rests a second, and the ground truth judges it.
+
+    Parameters
+    ----------
+    height : float  # [m]
+    distance : float  # [m] front axle to the edge
+    yaw : float  # [rad] the edge's
+    width : float  # [m] the top face along the edge
+    offset : float  # [m] the face centre along the edge
+    """
+    stack.settle(0.2)
+    stack.spawn_step(height, distance, yaw, width=width, depth=3.0)
+    result = stack.climb(ClimbRequest(
+        step_height=height, step_distance=distance, step_yaw=yaw,
+        step_width=width, step_offset=offset))
+    stack.settle(1.0)
+    rear = result.trajectory.between(*result.step_window('REAR'))
+    outcome, plan = result.outcome, result.plan
+    return Trial(
+        height, distance, yaw, width, offset, result.error_code, result.message,
+        stack.front_on_top(height), stack.four_wheels_on_top(height),
+        outcome.peak_torque if outcome else 0.0,
+        outcome.energy if outcome else 0.0,
+        plan.peak_torque if plan else math.nan,
+        plan.energy if plan else math.nan,
+        sign_changes(rear.swivel_torque),
+        float(np.max(np.abs(rear.swivel_torque), initial=0.0)),
+        plan.backup_distance if plan else 0.0,
+        result.success, outcome.duration if outcome else 0.0)
+
+
+def run_swivel(args: argparse.Namespace, config: StackConfig, ranges: RequestRanges,
                rng: random.Random) -> list[Trial]:
     trials = []
     with InProcessStack(config=config) as stack:
@@ -87,37 +166,17 @@ def run_swivel(args: argparse.Namespace, config: StackConfig,
             attempted = drawn = 0
             while attempted < args.trials and drawn < args.trials * args.max_draws:
                 drawn += 1
-                distance = rng.uniform(args.min_distance, args.max_distance)
-                yaw = rng.uniform(-args.max_yaw, args.max_yaw)
-                width = rng.uniform(args.min_width, args.max_width)
-                offset = rng.uniform(-args.max_offset, args.max_offset)
+                distance, yaw, width, offset = ranges.draw(rng)
                 stack.reset()
-                stack.settle(0.2)
-                stack.spawn_step(height, distance, yaw, width=width, depth=3.0)
-                result = stack.climb(ClimbRequest(
-                    step_height=height, step_distance=distance, step_yaw=yaw,
-                    step_width=width, step_offset=offset))
-                if result.error_code not in _NOT_ATTEMPTED:
+                trial = climb_trial(stack, height, distance, yaw, width, offset)
+                if trial.code not in _NOT_ATTEMPTED:
                     attempted += 1
-                stack.settle(1.0)
-                rear = result.trajectory.between(*result.step_window('REAR'))
-                outcome, plan = result.outcome, result.plan
-                trial = Trial(
-                    height, distance, yaw, width, offset, result.error_code, result.message,
-                    stack.front_on_top(height), stack.four_wheels_on_top(height),
-                    outcome.peak_torque if outcome else 0.0,
-                    outcome.energy if outcome else 0.0,
-                    plan.peak_torque if plan else math.nan,
-                    plan.energy if plan else math.nan,
-                    sign_changes(rear.swivel_torque),
-                    float(np.max(np.abs(rear.swivel_torque), initial=0.0)),
-                    plan.backup_distance if plan else 0.0)
                 trials.append(trial)
                 print(f'  {height:.2f} m  d {distance:.2f} m  yaw {yaw:+.2f} rad  width '
                       f'{width:.2f} m  offset {offset:+.2f} m  backup {trial.backup:.2f} m: '
                       f'{trial.code.name:<18} front '
                       f'{"up" if trial.front else "--"}  four {"up" if trial.four else "--"}'
-                      f'  ({result.message})', flush=True)
+                      f'  ({trial.message})', flush=True)
     return trials
 
 
@@ -255,12 +314,15 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument('--max-draws', type=int, default=4,
                         help='draw at most this many times --trials requests per height')
     parser.add_argument('--seed', type=int, default=1)
-    parser.add_argument('--min-distance', type=float, default=0.2, help='[m]')
-    parser.add_argument('--max-distance', type=float, default=1.0, help='[m]')
-    parser.add_argument('--max-yaw', type=float, default=0.3, help='[rad]')
-    parser.add_argument('--min-width', type=float, default=0.8, help='[m]')
-    parser.add_argument('--max-width', type=float, default=2.0, help='[m]')
-    parser.add_argument('--max-offset', type=float, default=0.0,
+    defaults = RequestRanges()
+    parser.add_argument('--min-distance', type=float, default=defaults.min_distance,
+                        help='[m]')
+    parser.add_argument('--max-distance', type=float, default=defaults.max_distance,
+                        help='[m]')
+    parser.add_argument('--max-yaw', type=float, default=defaults.max_yaw, help='[rad]')
+    parser.add_argument('--min-width', type=float, default=defaults.min_width, help='[m]')
+    parser.add_argument('--max-width', type=float, default=defaults.max_width, help='[m]')
+    parser.add_argument('--max-offset', type=float, default=defaults.max_offset,
                         help='[m] the face centre along the edge, drawn within +-this')
     parser.add_argument('--design', action='append', metavar='YAML',
                         help='a robot description parameter file (config/designs/*.yaml)')
@@ -280,12 +342,14 @@ def main(argv: list[str] | None = None) -> None:
         config = StackConfig.installed(
             robot=robot, controller=_assignments(args.controller),
             planner={'capability_file': 'none', **_assignments(args.planner)})
+        ranges = RequestRanges(**{item.name: getattr(args, item.name)
+                                  for item in fields(RequestRanges)})
     except ValueError as error:
         parser.error(str(error))
     rng = random.Random(args.seed)
     started = time.monotonic()
     print(f'swivel car: {args.trials} attempted climbs per height, seed {args.seed}')
-    trials = run_swivel(args, config, rng)
+    trials = run_swivel(args, config, ranges, rng)
     car_like = {} if args.skip_car_like else run_car_like(args, robot)
     report(trials, car_like, description)
     if args.write_capability:

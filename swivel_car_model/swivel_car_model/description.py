@@ -58,6 +58,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from swivel_car_model.checks import check_finite_number
 from swivel_car_model.params import SwivelCarParams
 
 ROBOT_VARIANTS = ('swivel', 'car_like')
@@ -123,9 +124,7 @@ class CarDescription:
                     raise ValueError(f'{item.name} must be one of {DIFFERENTIALS}, '
                                      f'got {value!r}')
                 continue
-            if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                    or not math.isfinite(value):
-                raise ValueError(f'{item.name} must be a finite number, got {value!r}')
+            check_finite_number(item.name, value)
             if item.name not in ('phi', 'body_offset', 'kp', 'ki', 'kd') and value <= 0.0:
                 raise ValueError(f'{item.name} must be > 0, got {value!r}')
         for name in ('kp', 'ki', 'kd'):

@@ -16,6 +16,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from swivel_car_model.checks import check_finite_number
+
 
 @dataclass(frozen=True)
 class SwivelCarParams:
@@ -75,8 +77,7 @@ class SwivelCarParams:
     def __post_init__(self) -> None:
         for field in fields(self):
             value = getattr(self, field.name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise ValueError(f'{field.name} must be a finite number, got {value!r}')
+            check_finite_number(field.name, value)
         for name in ('l', 'h', 'r', 'mass', 'inertia', 'wheel_width', 'wheel_mass',
                      'swivel_torque_limit'):
             if getattr(self, name) <= 0.0:

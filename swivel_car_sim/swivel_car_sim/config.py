@@ -3,10 +3,10 @@ frozen configuration read from it. ROS-free."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from swivel_car_model import description
+from swivel_car_model.checks import check_finite_number
 from swivel_car_sim.physics import SimConfig
 
 # name -> (default, description). The node declares exactly these: its own, then the robot
@@ -76,9 +76,7 @@ class SimNodeConfig:
                 if not isinstance(value, bool):
                     raise ValueError(f'{name} must be a bool, got {value!r}')
             elif isinstance(default, float):
-                if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                        or not math.isfinite(value):
-                    raise ValueError(f'{name} must be a finite number, got {value!r}')
+                check_finite_number(name, value)
                 v[name] = float(value)
             elif not isinstance(value, str):
                 raise ValueError(f'{name} must be a string, got {value!r}')

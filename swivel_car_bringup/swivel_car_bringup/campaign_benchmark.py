@@ -1,0 +1,119 @@
+"""Campaign benchmark: throughput on 1 and 2 Ray workers, and a campaign killed and resumed.
+
+    python -m swivel_car_bringup.campaign_benchmark [--trials 24] [--kill-resume [SWEEP]]
+
+Throughput: the same climbs (the default design, 3 and 5 cm steps about a metre ahead) on a
+local Ray with 1 worker, then with 2. Each worker first climbs one trial that is not counted:
+the first plan in a process fills the model's caches (seconds). Then trials per minute of wall
+time from submitting the counted trials to the last row written, and the ratio (target: 2
+workers at least 1.8x of 1 on this 2-core machine).
+
+``--kill-resume`` runs the campaign command on SWEEP (default: the installed
+``config/campaigns/mass_layout.yaml``, 216 climbs), kills it (SIGKILL) once half its trials are
+in the results file, runs the same command again to the end, and checks that every trial is in
+the file exactly once and the rows written before the kill are untouched (no trial redone).
+Prints; exit code 1 if that check fails.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import os
+from pathlib import Path
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+from ament_index_python.packages import get_package_share_directory
+
+from swivel_car_bringup.campaign import (
+    columns, key_columns, load_sweep, parse_sweep, plan_trials, ray_results, ray_session,
+    record)
+
+
+def _trials(count: int, seed: int, heights: list[float]) -> list:
+    """``count`` climbs of the default design that need no backing up."""
+    return plan_trials(parse_sweep({'trials': {
+        'heights': heights, 'count': -(-count // len(heights)), 'seed': seed, 'min_distance': 0.9,
+        'max_distance': 1.0, 'max_yaw': 0.1, 'min_width': 1.8, 'max_width': 2.0}}))[:count]
+
+
+def throughput(counted: list, workers: int, out: Path) -> float:
+    """Trials per minute of ``counted`` on a local Ray of ``workers`` warmed workers."""
+    with ray_session(workers, None) as at_once:
+        for _ in ray_results(_trials(at_once, 0, [0.03]), at_once):
+            pass
+        started = time.monotonic()
+        failed = record(ray_results(counted, at_once), out, len(counted), io.StringIO())
+        elapsed = time.monotonic() - started
+    if failed:
+        raise RuntimeError(f'{failed} trials raised')
+    return len(counted) / elapsed * 60.0
+
+
+def _rows(path: Path) -> list[list[str]]:
+    with path.open(newline='') as file:
+        return list(csv.reader(file))[1:]
+
+
+def kill_and_resume(sweep: Path, out: Path) -> bool:
+    """Run the campaign, SIGKILL it halfway, resume it; True if no trial was redone or
+    lost."""
+    total = len(plan_trials(load_sweep(sweep)))
+    command = [sys.executable, '-m', 'swivel_car_bringup.campaign', str(sweep),
+               '--out', str(out)]
+    print(f'kill and resume: {total} trials of {sweep}', flush=True)
+    started = time.monotonic()
+    first = subprocess.Popen(command, stderr=subprocess.DEVNULL)
+    while first.poll() is None and (not out.exists() or len(_rows(out)) < total // 2):
+        time.sleep(1.0)
+    first.send_signal(signal.SIGKILL)
+    first.wait()
+    killed = time.monotonic() - started
+    before = [row for row in _rows(out) if len(row) == len(columns())]
+    print(f'  killed after {killed:.0f} s with {len(before)} trials in the file', flush=True)
+    resumed = subprocess.run(command, stderr=subprocess.PIPE, text=True)
+    elapsed = time.monotonic() - started
+    after = _rows(out)
+    keys = [tuple(row[:len(key_columns())]) for row in after]
+    planned = {spec.key() for spec in plan_trials(load_sweep(sweep))}
+    said = [line for line in resumed.stderr.splitlines() if line.startswith('campaign:')]
+    print(f'  resumed, exit code {resumed.returncode}: {"; ".join(said)}')
+    print(f'  {len(after)} rows, {len(set(keys))} distinct trials of {total} planned; the rows '
+          f'before the kill {"untouched" if after[:len(before)] == before else "CHANGED"}; '
+          f'{elapsed / 60.0:.1f} min in all ({total / elapsed * 60.0:.1f} trials/min)')
+    ok = (resumed.returncode == 0 and len(keys) == len(set(keys)) == total
+          and set(keys) == planned and after[:len(before)] == before)
+    print(f'  {"OK: every trial once, none redone" if ok else "FAILED"}')
+    return ok
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--trials', type=int, default=24,
+                        help='counted trials per worker count')
+    parser.add_argument('--kill-resume', nargs='?', type=Path, metavar='SWEEP',
+                        const=Path(get_package_share_directory('swivel_car_bringup'))
+                        / 'config' / 'campaigns' / 'mass_layout.yaml',
+                        help='only the kill-and-resume check, of this sweep file')
+    args = parser.parse_args(argv)
+    with tempfile.TemporaryDirectory() as scratch:
+        if args.kill_resume:
+            sys.exit(0 if kill_and_resume(args.kill_resume, Path(scratch) / 'kill.csv')
+                     else 1)
+        rates = {}
+        counted = _trials(args.trials, 1, [0.03, 0.05])
+        for workers in (1, 2):
+            rates[workers] = throughput(counted, workers, Path(scratch) / f'{workers}.csv')
+            print(f'{workers} Ray worker(s): {rates[workers]:.1f} trials/min '
+                  f'({args.trials} climbs, warm workers)', flush=True)
+        print(f'2 workers / 1 worker: {rates[2] / rates[1]:.2f}x (target >= 1.8x; '
+              f'{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f})')
+
+
+if __name__ == '__main__':
+    main()
