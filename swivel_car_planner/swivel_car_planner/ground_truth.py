@@ -1,6 +1,6 @@
-"""Judging a climb by the sim's ground truth, ROS-free: shared by the system tests and the
-benchmark (through ``sim_session``, from ``ground_truth/odom``) and the in-process stack
-(``swivel_car_bringup.inprocess``, from the sim core's state)."""
+"""Judging a climb by the sim's ground truth, ROS-free: shared by the system tests (from
+``ground_truth/odom``) and the in-process stack (``swivel_car_bringup.inprocess``, from the sim
+core's state)."""
 
 from __future__ import annotations
 

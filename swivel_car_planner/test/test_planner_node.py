@@ -29,7 +29,7 @@ from swivel_car_testing import next_domain_id, spin_until
 from swivel_car_model import description
 
 from swivel_car_planner.core import Command, ErrorCode, Phase, PlannerConfig
-from swivel_car_planner.kinematic_car import DEFAULT_SWIVEL_RATE, DT, KinematicCar
+from kinematic_car import DEFAULT_SWIVEL_RATE, DT, KinematicCar
 from swivel_car_planner.planner_node import PlannerNode
 
 SUCCESSFUL_CLIMB = dict(step_height=0.04, step_distance=1.2, step_yaw=0.0)

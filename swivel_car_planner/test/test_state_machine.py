@@ -14,7 +14,7 @@ from swivel_car_planner.core import (
     ClimbRequest, ClimbStateMachine, Command, ErrorCode, Phase, PlannerConfig, make_plan)
 from swivel_car_planner.core.geometry import Pose2D, StepEdge
 from swivel_car_planner.core.state_machine import Step
-from swivel_car_planner.kinematic_car import KinematicCar
+from kinematic_car import KinematicCar
 
 P = SwivelCarParams()
 CONFIG = PlannerConfig()

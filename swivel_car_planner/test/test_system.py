@@ -9,7 +9,7 @@ from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.srv import ClimbStep
 
 from swivel_car_planner.core import ErrorCode, Phase
-from swivel_car_planner.sim_session import SimSession
+from sim_session import SimSession
 
 HEIGHT = 0.04  # [m] within the rear axle's traction limit (README: measured limits)
 DISTANCE = 1.2  # [m]

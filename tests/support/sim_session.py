@@ -62,10 +62,8 @@ class SimSession:
         joint = {'swivel_joint': 'steering_joint' if robot_variant == 'car_like'
                  else 'swivel_joint'}
         sim_time = {'use_sim_time': True, **joint}
-        # In the lockstep chain the planner's climbs do not depend on the machine's load. The
-        # pace (real time) is for the time before a climb's first command: then the sim runs
-        # free of the planner, and faster it would flood the planner with messages (seen:
-        # 3 s to take a request, its first commands 13 s of sim time late).
+        # In the lockstep chain the planner's climbs do not depend on the machine's load, and
+        # nothing outside it drives the car: the sim runs as fast as the chain answers.
         specs = [('swivel_car_sim', 'sim_node', {'robot_variant': robot_variant}),
                  ('swivel_car_control', 'controller_node', sim_time),
                  ('swivel_car_control', 'odometry_node', sim_time)]
@@ -78,7 +76,8 @@ class SimSession:
                 overrides = sim_parameters if executable == 'sim_node' else None
                 self.processes.append(start_node(
                     package, executable, self.domain_id,
-                    {**parameters, **lockstep_parameters(executable, LOCKSTEP_TIMEOUT),
+                    {**parameters, **lockstep_parameters(executable, LOCKSTEP_TIMEOUT,
+                                                         real_time_factor=0.0),
                      **(overrides or {})}))
             os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
             self.context = rclpy.Context()
