@@ -106,9 +106,9 @@ class SimNode(Node):
         now = time.monotonic()
         self._period_start_wall = now
         # The pace keeps an absolute schedule, so the timer's lag does not add up period by
-        # period (it did: 0.67x at a pace of 1x); a sim more than a period behind restarts it.
+        # period (it did: 0.67x at a pace of 1x); a sim behind it restarts it, never ahead.
         due = self._next_due_wall + self._lockstep_min_wall
-        self._next_due_wall = due if due >= now - self._lockstep_min_wall else now
+        self._next_due_wall = due if due >= now else now + self._lockstep_min_wall
         self._publish_state()
 
     def _advance_if_running(self) -> None:
