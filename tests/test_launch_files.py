@@ -52,3 +52,25 @@ def test_launch_file_names_installed_things(launch_file: Path):
                 and isinstance(node.value, str) and node.value.endswith('.launch.py')}
     for name in included:
         assert list(INSTALL_DIR.glob(f'*/share/*/launch/{name}')), f'{name} is not installed'
+
+
+def _respawned(launch_file: Path) -> dict[str, bool]:
+    """Executable -> whether its Node action has respawn=True."""
+    tree = ast.parse(launch_file.read_text(), filename=str(launch_file))
+    found = {}
+    for call in ast.walk(tree):
+        if isinstance(call, ast.Call) and _called_name(call) == 'Node':
+            keywords = {kw.arg: kw.value for kw in call.keywords}
+            respawn = keywords.get('respawn')
+            found[keywords['executable'].value] = isinstance(respawn, ast.Constant) \
+                and respawn.value is True
+    return found
+
+
+def test_a_dead_node_is_started_again_where_that_is_safe():
+    respawned = {}
+    for launch_file in LAUNCH_FILES:
+        respawned.update(_respawned(launch_file))
+    assert respawned['controller_node'] and respawned['odometry_node']
+    assert respawned['planner_node']
+    assert not respawned['sim_node']  # a new sim is a new world

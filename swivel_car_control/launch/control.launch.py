@@ -33,14 +33,17 @@ def generate_launch_description():
             'odometry_params',
             default_value=os.path.join(share, 'config', 'odometry_node.yaml'),
             description='odometry parameter file'),
+        # A dead controller or odometry is started again: the sim's watchdog has stopped the
+        # car meanwhile, a new controller holds until commanded, a new odometry starts a new
+        # odom frame at the origin, as at launch (a planner's climb ends NOT_READY).
         Node(package='swivel_car_control', executable='controller_node', name='controller',
-             namespace=namespace, output='screen',
+             namespace=namespace, output='screen', respawn=True, respawn_delay=1.0,
              parameters=[LaunchConfiguration('controller_params'),
                          {'use_sim_time': ParameterValue(use_sim_time, value_type=bool),
                           'use_stamped': ParameterValue(LaunchConfiguration('use_stamped'),
                                                         value_type=bool)}]),
         Node(package='swivel_car_control', executable='odometry_node', name='odometry',
-             namespace=namespace, output='screen',
+             namespace=namespace, output='screen', respawn=True, respawn_delay=1.0,
              parameters=[LaunchConfiguration('odometry_params'),
                          {'use_sim_time': ParameterValue(use_sim_time, value_type=bool)}]),
     ])

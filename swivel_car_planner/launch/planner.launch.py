@@ -20,9 +20,12 @@ def generate_launch_description() -> LaunchDescription:
                               description='planner parameter file'),
         DeclareLaunchArgument('use_sim_time', default_value='true',
                               description='run on the sim clock (/clock)'),
+        # A dead planner is started again: its climb's client got no answer, the controller's
+        # swivel_command deadman stopped the car, and a new planner starts with no climb.
         Node(
             package='swivel_car_planner', executable='planner_node', name='planner',
             namespace=LaunchConfiguration('namespace'), output='screen',
+            respawn=True, respawn_delay=1.0,
             parameters=[
                 LaunchConfiguration('params_file'),
                 {'use_sim_time': ParameterValue(LaunchConfiguration('use_sim_time'),

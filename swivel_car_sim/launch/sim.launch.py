@@ -25,6 +25,7 @@ def generate_launch_description():
         DeclareLaunchArgument('robot_variant', default_value='swivel',
                               description='swivel | car_like'),
     ]
+    # Not respawned: a new sim is a new world (the robot at the origin, no obstacles).
     sim = Node(
         package='swivel_car_sim', executable='sim_node', name='sim', output='screen',
         parameters=[
