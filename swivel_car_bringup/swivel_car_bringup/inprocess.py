@@ -413,6 +413,11 @@ class InProcessStack:
         self.sim.reset(x, y, yaw, remove_obstacles=True)
         self._start_nodes()
 
+    def reset_odometry(self) -> None:
+        """The odometry's pose to the origin and its last twist forgotten, as odometry_node's
+        ``~/reset``; the car does not move."""
+        self.odometry.odometry.reset()
+
     def spawn_step(self, height: float, distance: float, yaw: float = 0.0,
                    width: float = 3.0, depth: float = 2.0, friction: float = 1.0,
                    name: str = '') -> str:

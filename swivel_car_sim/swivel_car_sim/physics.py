@@ -67,6 +67,10 @@ class SimConfig:
     ground_friction : float
         Coulomb friction coefficient of the ground (pybullet multiplies it with the tyres'
         ``description.wheel_friction``). # [1]
+    body_collision : bool
+        Give the body (columns, axle housings, central body) collision shapes, not only the
+        wheels: for a phi < 0 robot, whose belly hangs below the axle line
+        (``swivel_car_sim.urdf``). Needs a robot whose body clears the ground at rest.
     """
 
     description: CarDescription = field(default_factory=CarDescription)
@@ -75,6 +79,7 @@ class SimConfig:
     gui: bool = False
     watchdog_timeout: float = 0.5  # [s]
     ground_friction: float = 1.0  # [1]
+    body_collision: bool = False
 
     def __post_init__(self) -> None:
         if self.robot_variant not in ROBOT_VARIANTS:
@@ -83,6 +88,8 @@ class SimConfig:
         _require(0.0 < self.time_step <= 0.01, 'time_step', self.time_step, 'in (0, 0.01] s')
         _require(self.ground_friction > 0.0, 'ground_friction', self.ground_friction, '> 0')
         _require(self.watchdog_timeout >= 0.0, 'watchdog_timeout', self.watchdog_timeout, '>= 0')
+        if not isinstance(self.body_collision, bool):
+            raise ValueError(f'body_collision must be a bool, got {self.body_collision!r}')
 
     @property
     def params(self) -> SwivelCarParams:
@@ -230,7 +237,8 @@ class SwivelCarSim:
         self.config = config or SimConfig()
         self.description = self.config.description
         self.params = self.config.params
-        self.robot: RobotModel = build_robot(self.description, self.config.robot_variant)
+        self.robot: RobotModel = build_robot(self.description, self.config.robot_variant,
+                                             body_collision=self.config.body_collision)
         self.gains = DriveGains.for_robot(self.params, self.config.time_step)
         self._rear_locked = self.description.rear_differential == 'locked'
         self._front_locked = self.description.front_differential == 'locked'
@@ -455,6 +463,19 @@ class SwivelCarSim:
             heights.append(s[4][2] + (self.params.r * down[2] / norm if norm > 1e-9
                                       else 0.0))
         return np.array(heights)
+
+    def body_clearance(self) -> float:
+        """Smallest distance from the body's collision shapes to the ground and the
+        obstacles, 1 m if farther; negative when they touch (penetration). Needs
+        ``SimConfig.body_collision``. # [m]"""
+        if not self.config.body_collision:
+            raise ValueError('body_clearance needs SimConfig(body_collision=True)')
+        reach = 1.0  # [m]
+        distances = [point[8] for other in (self._ground, *self._obstacles.values())
+                     for link in (-1, self._joint_ids[0])
+                     for point in self._pb.getClosestPoints(self._body, other, reach,
+                                                            linkIndexA=link)]
+        return min(distances, default=reach)
 
     # --- replay and rendering --------------------------------------------------------------
 

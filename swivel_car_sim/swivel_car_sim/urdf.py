@@ -6,9 +6,12 @@ else is decided in this module but how a link is written. ``base_link`` is the m
 rear axle at wheel-centre height (x forward, y left, z up); the swivel joint turns the front T
 about the front column's axis through the apex; wheels sit at ``y = +-h`` on each axle.
 
-Only the wheels have collision shapes: the columns of a phi < 0 design would otherwise cut the
-ground (thesis Fig. 15b says such a design needs a different body), and the climbing contact
-that matters is the wheel's.
+By default only the wheels have collision shapes: the climbing contact that matters for the
+phi > 0 robot is the wheel's (its body rides 13 cm above the axle line, above every step it
+climbs), and the phi < 0 designs of the thesis' Table 2 (apex under the ground, thesis Fig. 15b)
+can still be simulated. ``body_collision`` gives every other part its shape too: a phi < 0
+robot that can exist (``swivel_car_model/config/designs/phi_negative.yaml``) hangs its apex
+below the axle line, and its belly is what meets a step edge first.
 """
 
 from __future__ import annotations
@@ -78,18 +81,21 @@ def _rpy_z_to(direction: np.ndarray) -> np.ndarray:
     return np.array([0.0, math.acos(max(-1.0, min(1.0, d[2]))), math.atan2(d[1], d[0])])
 
 
-def _visual(part: Part, origin: np.ndarray) -> str:
-    """The part's <visual> in the frame of a link whose origin is ``origin`` [m]."""
+def _shape(part: Part, origin: np.ndarray) -> str:
+    """The part's <origin> and <geometry> in the frame of a link whose origin is ``origin``
+    [m]."""
     centre = part.com - origin
-    material = _MATERIALS.get(part.name, 'frame')
     if part.shape == 'box':
-        return (f'<visual><origin xyz="{_fmt(centre)}" rpy="0 0 0"/>'
-                f'<geometry><box size="{_fmt(part.size)}"/></geometry>'
-                f'<material name="{material}"/></visual>')
+        return (f'<origin xyz="{_fmt(centre)}" rpy="0 0 0"/>'
+                f'<geometry><box size="{_fmt(part.size)}"/></geometry>')
     radius, length = part.size
-    return (f'<visual><origin xyz="{_fmt(centre)}" rpy="{_fmt(_rpy_z_to(part.axis))}"/>'
-            f'<geometry><cylinder radius="{radius:.9g}" length="{length:.9g}"/></geometry>'
-            f'<material name="{material}"/></visual>')
+    return (f'<origin xyz="{_fmt(centre)}" rpy="{_fmt(_rpy_z_to(part.axis))}"/>'
+            f'<geometry><cylinder radius="{radius:.9g}" length="{length:.9g}"/></geometry>')
+
+
+def _visual(part: Part, origin: np.ndarray) -> str:
+    material = _MATERIALS.get(part.name, 'frame')
+    return f'<visual>{_shape(part, origin)}<material name="{material}"/></visual>'
 
 
 def _link(name: str, parts: list[Part], origin: np.ndarray, collision: str = '') -> str:
@@ -132,7 +138,8 @@ def _wheel_collision(d: CarDescription) -> str:
 
 
 def build_robot(description: CarDescription, variant: str = 'swivel',
-                max_steering: float = CAR_LIKE_MAX_STEERING) -> RobotModel:
+                max_steering: float = CAR_LIKE_MAX_STEERING,
+                body_collision: bool = False) -> RobotModel:
     """Generate the URDF of a swivel car or of the car-like baseline.
 
     Parameters
@@ -145,6 +152,9 @@ def build_robot(description: CarDescription, variant: str = 'swivel',
         wheelbase and track).
     max_steering : float
         Steering limit of the car-like baseline. # [rad]
+    body_collision : bool
+        Give the columns, axle housings and central body collision shapes too (default:
+        the wheels only; see the module docstring).
 
     Returns
     -------
@@ -182,7 +192,9 @@ def build_robot(description: CarDescription, variant: str = 'swivel',
             '  <material name="body"><color rgba="0.9 0.5 0.1 1"/></material>\n'
             '  <material name="tyre"><color rgba="0.1 0.1 0.1 1"/></material>\n'
             + ''.join(_link(link, [p for p in parts if p.link == link], origins[link],
-                            collision if link in WHEEL_LINKS else '')
+                            collision if link in WHEEL_LINKS else
+                            _body_collisions(parts, link, origins[link]) if body_collision
+                            else '')
                       for link in (BASE_LINK, front_link) + WHEEL_LINKS)
             + _joint(steer_joint, 'revolute', BASE_LINK, front_link, front_origin,
                      axis=steer_axis, limit=steer_limit)
@@ -192,6 +204,11 @@ def build_robot(description: CarDescription, variant: str = 'swivel',
             + '</robot>\n')
     return RobotModel(text, variant, steer_joint, WHEEL_JOINTS, total_mass,
                       inertia_about_y_axis(parts), com)
+
+
+def _body_collisions(parts: list[Part], link: str, origin: np.ndarray) -> str:
+    return '\n    '.join(f'<collision>{_shape(p, origin)}</collision>'
+                         for p in parts if p.link == link)
 
 
 def _description_text(d: CarDescription) -> str:
