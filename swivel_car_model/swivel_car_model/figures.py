@@ -457,6 +457,26 @@ def headline_claims() -> list[Claim]:
     return claims
 
 
+HAND_WRITTEN = 'Written by hand (`python -m swivel_car_model.figures` does not write this section)'
+
+
+def hand_written_sections(path: Path) -> list[str]:
+    """The lines of each ``## `` section of the existing document at ``path`` whose text
+    starts with ``HAND_WRITTEN`` (measurements in physics, which the model cannot make), so
+    that writing the table again keeps them."""
+    if not path.exists():
+        return []
+    kept, section = [], []
+    for line in path.read_text().splitlines() + ['## ']:
+        if line.startswith('## '):
+            body = [text for text in section[1:] if text.strip()]
+            if body and body[0].startswith(HAND_WRITTEN):
+                kept += section
+            section = []
+        section.append(line)
+    return kept
+
+
 def write_table(path: Path, claims: list[Claim], figures: list[str]) -> None:
     lines = [
         '# Thesis reproduction',
@@ -473,6 +493,7 @@ def write_table(path: Path, claims: list[Claim], figures: list[str]) -> None:
                      f'{c.why_not if not c.reproduces else ""} |')
     lines += ['', f'Figures ({len(figures)}; `python -m swivel_car_model.benchmark` times them): '
               + ', '.join(f'[{name}](figures/{name})' for name in figures), '']
+    lines += hand_written_sections(path)
     if CORRECTIONS.exists():
         lines += [CORRECTIONS.read_text().rstrip(), '']
     path.write_text('\n'.join(lines))

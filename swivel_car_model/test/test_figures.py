@@ -17,6 +17,16 @@ def test_selected_figures_are_written(tmp_path):
     assert not (tmp_path.parent / 'thesis_reproduction.md').exists()
 
 
+def test_writing_the_table_keeps_the_hand_written_sections(tmp_path):
+    doc = tmp_path / 'thesis_reproduction.md'
+    doc.write_text(f'# old\n\n## Measured in physics\n\n{figures.HAND_WRITTEN}: kept.\n\n'
+                   '| a |\n\n## Generated\n\nan old generated line\n')
+    figures.write_table(doc, [], [])
+    text = doc.read_text()
+    assert f'{figures.HAND_WRITTEN}: kept.\n\n| a |' in text
+    assert 'an old generated line' not in text and '# old' not in text
+
+
 def test_every_required_figure_has_a_maker():
     required = {18, 20, 21, 25, 26, 27, 28, 29, 31, 32, 35, 38, 40, 48, 49, 50, 51, 54, 55, 56,
                 57, 58, 60, 61}

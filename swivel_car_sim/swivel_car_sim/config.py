@@ -35,6 +35,8 @@ PARAMETERS: dict[str, tuple[object, str]] = {
     'imu_rate': (100.0, '[Hz] imu publish rate; control_period divided by a whole number'),
     'ground_truth_rate': (100.0, '[Hz] ground_truth/odom publish rate; as imu_rate'),
     'ground_friction': (1.0, '[1] friction coefficient of the ground'),
+    'body_collision': (False, 'give the body collision shapes too, not only the wheels (a '
+                              'phi < 0 robot, whose belly meets step edges)'),
     **description.PARAMETERS,
 }
 
@@ -85,7 +87,7 @@ class SimNodeConfig:
         physics = SimConfig(
             description=robot, robot_variant=v['robot_variant'], time_step=v['time_step'],
             gui=v['gui'], watchdog_timeout=v['watchdog_timeout'],
-            ground_friction=v['ground_friction'])
+            ground_friction=v['ground_friction'], body_collision=v['body_collision'])
         steps = _whole_ratio(v['control_period'], physics.time_step, 'control_period',
                              'time_step')
         if v['real_time_factor'] < 0.0:

@@ -7,11 +7,12 @@ rear axle at wheel-centre height (x forward, y left, z up); the swivel joint tur
 about the front column's axis through the apex; wheels sit at ``y = +-h`` on each axle.
 
 By default only the wheels have collision shapes: the climbing contact that matters for the
-phi > 0 robot is the wheel's (its body rides 13 cm above the axle line, above every step it
-climbs), and the phi < 0 designs of the thesis' Table 2 (apex under the ground, thesis Fig. 15b)
-can still be simulated. ``body_collision`` gives every other part its shape too: a phi < 0
-robot that can exist (``swivel_car_model/config/designs/phi_negative.yaml``) hangs its apex
-below the axle line, and its belly is what meets a step edge first.
+phi > 0 robot is the wheel's (its belly, above the axle line, would first meet the edge of a
+13.5 cm step, higher than it climbs), and the phi < 0 designs of the thesis' Table 2 (apex
+under the ground, thesis Fig. 15b) can still be simulated. ``body_collision`` gives every
+other part its shape too: a phi < 0 robot that can exist
+(``swivel_car_model/config/designs/phi_negative.yaml``) hangs its apex below the axle line,
+and its belly is what meets a step edge first.
 """
 
 from __future__ import annotations
