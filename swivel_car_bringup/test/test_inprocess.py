@@ -1,5 +1,6 @@
 """InProcessStack: fast, deterministic checks of the in-process stack (no ROS, sim time only).
-Its identity with the ROS lockstep run is tests/test_inprocess_identity.py."""
+Its identity with the ROS lockstep run, bit for bit per control period, is checked by
+tests/test_inprocess_identity.py."""
 
 from __future__ import annotations
 
@@ -45,6 +46,17 @@ def test_a_short_drive_moves_forward_and_records_every_period(stack):
     # The cmd_vel deadman stops the car once drive() no longer renews the command.
     stack.settle(1.5)
     assert stack.ground_truth().speed < 0.01
+
+
+def test_reset_odometry_moves_the_odometry_to_the_origin_not_the_car(stack):
+    stack.drive(0.3, 0.0, 0.5)
+    before = stack.ground_truth()
+    stack.reset_odometry()
+    odometry = stack.odometry.odometry
+    assert (odometry.x, odometry.y, odometry.yaw, odometry.v) == (0.0, 0.0, 0.0, 0.0)
+    assert stack.ground_truth() == before
+    stack.drive(0.3, 0.0, 0.5)
+    assert odometry.x == pytest.approx(stack.ground_truth().x - before.x, abs=0.01)
 
 
 def test_the_same_calls_give_the_same_floats():
