@@ -240,24 +240,13 @@ def advance_arc(p: SwivelCarParams, config: PlannerConfig, swivel: float, side: 
                     f'wheel get over the edge with the other front wheel clear of the riser')
 
 
-def lifted_lowest_point(p: SwivelCarParams, swivel: float) -> tuple[float, float]:
-    """The lifted front wheel's lowest rim point in base_link (level) at ``swivel`` (model):
-    both wheels share the shaft, so it lies from the lifted wheel's centre as the grounded
-    wheel's contact lies from its own. # [m]"""
-    frames = kinematics.forward_kinematics(p, swivel)
-    right, left = frames.o3[:2, 3], frames.o3_left[:2, 3]
-    lifted, grounded = (left, right) if swivel > 0.0 else (right, left)
-    contact = np.array([float(v) for v in kinematics.contact_point(p, swivel)])
-    x, y = lifted + contact - grounded
-    return float(x), float(y)
-
-
 def landing_point(p: SwivelCarParams, height: float, side: int) -> tuple[float, float]:
     """Where in base_link (level) the lifted wheel on ``side`` touches a step of ``height``
     as the swivel sets it down: its lowest point at the swivel that puts it at that height
     (it moves back as the swivel comes down from the lift). # [m]"""
     swivel = float(kinematics.swivel_for_step(p, height, respect_tip_over=False))
-    return lifted_lowest_point(p, side * swivel)
+    x, y, _ = climbing.lifted_wheel_lowest_point(p, side * swivel)
+    return float(x), float(y)
 
 
 def push_advance(p: SwivelCarParams, config: PlannerConfig, swivel: float, side: int,
