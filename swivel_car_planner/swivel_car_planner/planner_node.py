@@ -11,9 +11,8 @@ busy-wait at full CPU while a climb ran.)
 
 from __future__ import annotations
 
-import sys
-
 import math
+import sys
 import time
 from dataclasses import dataclass, fields, replace
 
@@ -24,7 +23,6 @@ from rclpy.action.server import ServerGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.clock import Clock, ClockType
 from rclpy.executors import SingleThreadedExecutor
-from swivel_car_ros.ros_params import declare_description, run_node
 from rclpy.node import Node
 from rclpy.task import Future
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
@@ -33,6 +31,7 @@ from swivel_car_model import dynamics, kinematics
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
+from swivel_car_ros.ros_params import declare_description, run_node
 
 from swivel_car_planner.conversions import outcome_to_msg, plan_to_msg, request_from
 from swivel_car_planner.core import (

@@ -291,7 +291,7 @@ class SwivelCarSim:
     @property
     def time(self) -> float:
         """Sim time. # [s]"""
-        return self._steps * self.config.time_step
+        return self._steps * self._time_step
 
     def set_command(self, swivel_torque: float, drive_speed: float) -> None:
         """Take an actuator command (clamped to the limits); it feeds the watchdog.
@@ -315,8 +315,7 @@ class SwivelCarSim:
     def watchdog_tripped(self) -> bool:
         """True while the last command is older than the watchdog timeout."""
         timeout = self._watchdog_timeout
-        return timeout > 0.0 and self._steps * self._time_step - self._command_time > \
-            timeout + 1e-9
+        return timeout > 0.0 and self.time - self._command_time > timeout + 1e-9
 
     def step(self, steps: int = 1) -> None:
         """Advance the physics by ``steps`` time steps (1 .. 100000)."""

@@ -4,11 +4,9 @@ would offer, owner of /clock, with a deterministic lockstep mode (docs/architect
 from __future__ import annotations
 
 import sys
-
 import time
 
 from rclpy.clock import Clock, ClockType
-from swivel_car_ros.ros_params import run_node
 from rclpy.node import Node
 from rclpy.time import Time
 from rcl_interfaces.msg import ParameterDescriptor
@@ -19,6 +17,7 @@ from std_srvs.srv import SetBool
 from swivel_car_msgs.msg import ActuatorCommand
 from swivel_car_msgs.srv import (RemoveObstacle, ResetSimulation, SpawnObstacle,
                                  StepSimulation)
+from swivel_car_ros.ros_params import run_node
 
 from swivel_car_sim.config import PARAMETERS, SimNodeConfig
 from swivel_car_sim.conversions import sim_time_msg, StateMessages
