@@ -20,7 +20,9 @@ def test_default_config_is_valid():
     ('climb_speed', math.nan), ('clearance_margin', -0.01), ('swivel_rate', 0.0),
     ('max_step_yaw', math.pi / 2), ('time_allowance', math.inf), ('stall_time', True),
     ('stop_speed', 0.0), ('stop_speed', math.nan), ('max_backup', -0.1),
-    ('max_backup', math.inf), ('stop_allowance', -0.1), ('rest_tolerance', math.nan)])
+    ('max_backup', math.inf), ('stop_allowance', -0.1), ('rest_tolerance', math.nan),
+    ('push_lift_height', -0.01), ('push_lead', 0.0), ('push_lead', math.pi / 2),
+    ('push_gap', math.nan), ('push_margin', -0.05), ('set_down_speed', 0.0)])
 def test_bad_config_names_the_field(name, value):
     with pytest.raises(ValueError, match=name):
         PlannerConfig(**{name: value})

@@ -40,6 +40,7 @@ def test_rates_and_geometry_overrides():
     ({'real_time_factor': math.inf}, 'real_time_factor'),
     ({'lockstep': 1}, 'lockstep'),
     ({'gui': 'yes'}, 'gui'),
+    ({'body_collision': 1}, 'body_collision'),
     ({'r': -0.075}, 'r must be > 0'),
     ({'phi': 2.0}, 'phi'),
     ({'robot_variant': 3}, 'robot_variant'),

@@ -107,7 +107,8 @@ class PlannerConfig:
             if value < 0.0:
                 raise ValueError(f'{item.name} must be >= 0, got {value!r}')
         for name in ('max_step_distance', 'max_step_yaw', 'max_lead_angle', 'push_lead',
-                     'approach_speed', 'climb_speed', 'rear_speed', 'swivel_rate', 'max_steer',
+                     'approach_speed', 'climb_speed', 'rear_speed', 'set_down_speed',
+                     'swivel_rate', 'max_steer',
                      'swivel_tolerance', 'settle_rate', 'stop_speed',
                      'stall_progress',
                      'stall_time', 'slip_yaw_tolerance', 'no_progress_time', 'min_progress',
