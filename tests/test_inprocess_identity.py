@@ -167,7 +167,6 @@ def ros_run():
     return result, first_tick, recorder, logs
 
 
-@pytest.mark.unpaced
 def test_a_ros_lockstep_climb_is_the_in_process_climb(ros_run):
     ros, first_tick, recorder, logs = ros_run
     # The chain must have held: no node went on without the command it waits for.
