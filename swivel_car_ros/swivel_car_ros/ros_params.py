@@ -114,7 +114,7 @@ def run_node(node_class: type[Node], name: str, args: list[str] | None = None,
     Returns the process exit code (0, or 1 for a configuration error).
     """
     rclpy.init(args=args)
-    node = None
+    node = executor = None
     try:
         node = node_class()
         # EventsExecutor: a message hop in a quarter of the SingleThreadedExecutor's time,
@@ -135,6 +135,11 @@ def run_node(node_class: type[Node], name: str, args: list[str] | None = None,
         else:
             raise
     finally:
+        # The executor first: an EventsExecutor torn down by the garbage collector after its
+        # node's entities are gone aborts the process ('Destroying callback manager with
+        # callbacks remaining'), seen once on a recorder stopped while it subscribed.
+        if executor is not None:
+            executor.shutdown()
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
