@@ -1,5 +1,7 @@
 #!/usr/bin/env python3
-"""Real-time factor of the ROS lockstep chain during a climb:
+"""
+Real-time factor of the ROS lockstep chain during a climb.
+
 ``scripts/in_ws python scripts/chain_benchmark.py [--height 0.04] [--distance 1.2]``.
 
 Starts the installed sim_node, controller_node, odometry_node and planner_node as processes,
@@ -16,17 +18,16 @@ from __future__ import annotations
 
 import argparse
 import os
-import time
 from pathlib import Path
+import time
 
 import rclpy
-import yaml
 from rclpy.executors import SingleThreadedExecutor
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand
 from swivel_car_msgs.srv import ClimbStep, SpawnObstacle
-
 from swivel_car_stack import (
-    NodeProcess, config_path, lockstep_parameters, spin_until, start_node)
+    config_path, lockstep_parameters, NodeProcess, spin_until, start_node)
+import yaml
 
 NODES = (('swivel_car_sim', 'sim_node'), ('swivel_car_control', 'controller_node'),
          ('swivel_car_control', 'odometry_node'), ('swivel_car_planner', 'planner_node'))
@@ -47,7 +48,7 @@ def run_time(pid: int) -> float:
 
 
 def control_period() -> float:
-    """The installed sim config's control period [s]: what the started sim runs."""
+    """Return the installed sim config's control period [s]: what the started sim runs."""
     config = yaml.safe_load(config_path('swivel_car_sim', 'sim_node.yaml').read_text())
     return float(config['/**']['sim']['ros__parameters']['control_period'])
 
@@ -71,8 +72,11 @@ class Client:
         return future.result()
 
     def wait_ready(self, timeout: float) -> None:
-        """Until the planner hears the whole stack: a step out of reach is then refused as
-        unreachable, not as not ready."""
+        """
+        Wait until the planner hears the whole stack.
+
+        A step out of reach is then refused as unreachable, not as not ready.
+        """
         spin_until(self.executor, lambda: self.spawn.service_is_ready()
                    and self.climb.service_is_ready(), timeout, 'the services')
         deadline = time.monotonic() + timeout
@@ -153,7 +157,7 @@ def report(args: argparse.Namespace, response: ClimbStep.Response, wall: float,
     for (_, executable), seconds in zip(NODES, cpu):
         print(f'    {executable:16s} {seconds / periods * 1e6:6.0f} us')
     print(f'    {"all four":16s} {sum(cpu) / periods * 1e6:6.0f} us  (= '
-          f'{sum(cpu) / wall:.2f} of the {os.cpu_count()} cores busy; this benchmark\'s own '
+          f"{sum(cpu) / wall:.2f} of the {os.cpu_count()} cores busy; this benchmark's own "
           f'process {own / periods * 1e6:.0f} us)')
 
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""The main job: the simulated swivel car drives to a step and climbs it.
+"""
+The main job: the simulated swivel car drives to a step and climbs it.
 
 Starts the stack the way a user would with `ros2 run`: the installed `sim_node`,
 `controller_node`, `odometry_node` and `planner_node`, each in its own process, headless, on
@@ -14,15 +15,16 @@ from __future__ import annotations
 
 import argparse
 import os
+from pathlib import Path
 import shutil
 import sys
 import time
-from pathlib import Path
 
-import numpy as np
-import rclpy
+from demo_report import read_bag, Recording, write_report
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
+import numpy as np
+import rclpy
 from rclpy.action import ActionClient
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -31,11 +33,9 @@ from swivel_car_msgs.action import ClimbStep
 from swivel_car_msgs.msg import StepObstacle
 from swivel_car_msgs.srv import SpawnObstacle
 from swivel_car_planner.core import capability
-
-from demo_report import read_bag, Recording, write_report
 from swivel_car_sim.physics import StepSpec
 from swivel_car_stack import (
-    NodeProcess, REPO_ROOT, lockstep_parameters, spin_until, start_node)
+    lockstep_parameters, NodeProcess, REPO_ROOT, spin_until, start_node)
 
 NODES = (('swivel_car_sim', 'sim_node'), ('swivel_car_control', 'controller_node'),
          ('swivel_car_control', 'odometry_node'), ('swivel_car_planner', 'planner_node'))
@@ -98,8 +98,12 @@ class DemoNode(Node):
 
 
 class Progress:
-    """One progress line: rewritten in place on a terminal; otherwise a line whenever the
-    phase changes and every few seconds."""
+    """
+    One progress line.
+
+    Rewritten in place on a terminal; otherwise a line whenever the phase changes and every
+    few seconds.
+    """
 
     PERIOD = 3.0  # [s] wall, between lines when not on a terminal
 
@@ -128,14 +132,17 @@ class DemoError(RuntimeError):
 
 
 def demo_step(args: argparse.Namespace) -> StepSpec:
-    """The step the demo spawns, square across the car's path."""
+    """Return the step the demo spawns, square across the car's path."""
     return StepSpec(name='demo_step', height=args.step_height, depth=1.0, width=2.4,
                     distance=args.step_distance, yaw=0.0, friction=1.0)
 
 
 def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Recording]:
-    """Start the stack, drive to the step, climb it. Returns the summary figures and what
-    was recorded."""
+    """
+    Start the stack, drive to the step, climb it.
+
+    Returns the summary figures and what was recorded.
+    """
     domain_id = args.domain_id
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     # Beside the stack, as `stack.launch.py record:=true` starts them: the robot model on the
@@ -177,6 +184,7 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
 
         start_x = node.recording.odom[-1][1]
         drive_to = args.step_distance - args.stop_before
+
         def travelled() -> float:
             return node.recording.odom[-1][1] - start_x
         while travelled() < drive_to:
@@ -197,7 +205,8 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
 
         goal = ClimbStep.Goal(step_height=args.step_height,
                               step_distance=args.step_distance - travelled(), step_yaw=0.0,
-                              step_width=step.width, plan_only=False, time_allowance=args.time_allowance)
+                              step_width=step.width, plan_only=False,
+                              time_allowance=args.time_allowance)
         climb_start = node.recording.truth[-1][0]
         sent = node.climb.send_goal_async(goal, feedback_callback=lambda f: progress.show(
             f.feedback.phase_name, f'{100 * f.feedback.progress:3.0f} %  swivel '
@@ -261,7 +270,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--step-height', type=float, default=None,
                         help='[m] default: the highest step the whole car climbs reliably, '
-                        'the planner\'s installed capability table')
+                        "the planner's installed capability table")
     parser.add_argument('--step-distance', type=float, default=1.8,
                         help='[m] front axle ground contact to the step edge at the start')
     parser.add_argument('--stop-before', type=float, default=1.0,

@@ -1,6 +1,9 @@
-"""The demo's report: plots of what the stack did and frames of the climb rendered by
-pybullet's own renderer, in one markdown page beside its PNGs, all drawn from the run's
-rosbag2 bag (read with rosbags, from the message definitions in the bag)."""
+"""
+The demo's report: plots of what the stack did and frames of the climb.
+
+The frames are rendered by pybullet's own renderer; one markdown page beside its PNGs, all
+drawn from the run's rosbag2 bag (read with rosbags, from the message definitions in the bag).
+"""
 
 from __future__ import annotations
 
@@ -8,13 +11,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+from rosbags.highlevel import AnyReader
+from swivel_car_model.params import SwivelCarParams
+from swivel_car_sim.physics import SimConfig, StepSpec, SwivelCarSim
 
 matplotlib.use('Agg')
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from rosbags.highlevel import AnyReader  # noqa: E402
-from swivel_car_model.params import SwivelCarParams  # noqa: E402
-from swivel_car_sim.physics import SimConfig, StepSpec, SwivelCarSim  # noqa: E402
 
 FRAME_COUNT = 8
 
@@ -37,7 +40,7 @@ def _seconds(header) -> float:
 
 
 def read_bag(path: Path) -> Recording:
-    """The report's time series from a bag the recorder wrote."""
+    """Read the report's time series from a bag the recorder wrote."""
     recording = Recording()
     with AnyReader([path]) as reader:
         wanted = [c for c in reader.connections if c.topic in (
@@ -61,7 +64,7 @@ def read_bag(path: Path) -> Recording:
 
 
 def _pitch(quaternions: np.ndarray) -> np.ndarray:
-    """REP-103 pitch (positive nose down) of rows of (x, y, z, w). # [rad]"""
+    """Return the REP-103 pitch (positive nose down) of rows of (x, y, z, w) [rad]."""
     x, y, z, w = quaternions.T
     return np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0))
 
@@ -118,9 +121,13 @@ def plot_time_series(recording, summary: dict, out: Path) -> None:
 
 
 def render_frames(recording, summary: dict, step: StepSpec, folder: Path) -> None:
-    """Replay the recorded ground truth and joint angles in a fresh pybullet world holding
-    the same robot and step, and render with pybullet's renderer: a strip of frames of the
-    climb (frames.png) and, larger, the moment the swivel is turned furthest (car.png)."""
+    """
+    Replay the recorded climb in a fresh pybullet world and render it.
+
+    The recorded ground truth and joint angles, in a world holding the same robot and step,
+    rendered with pybullet's renderer: a strip of frames of the climb (frames.png) and,
+    larger, the moment the swivel is turned furthest (car.png).
+    """
     truth = np.array(recording.truth)
     joint_times = np.array([t for t, _ in recording.joints])
     swivel_index = recording.joint_names.index('swivel_joint')

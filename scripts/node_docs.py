@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
-"""The README's node tables, generated from the nodes themselves: each node is constructed
-in-process with its defaults and asked, as `ros2 node info` and `ros2 param describe` would,
-for its topics, services, actions and parameters. So the tables cannot drift from the code.
+"""
+The README's node tables, generated from the nodes themselves.
+
+Each node is constructed in-process with its defaults and asked, as `ros2 node info` and
+`ros2 param describe` would, for its topics, services, actions and parameters. So the tables
+cannot drift from the code.
 
     scripts/in_ws python scripts/node_docs.py --write README.md   # regenerate
     scripts/in_ws python scripts/node_docs.py --check README.md   # exit 1 if stale (a test)
@@ -10,9 +13,9 @@ for its topics, services, actions and parameters. So the tables cannot drift fro
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 import sys
 import time
-from pathlib import Path
 
 import rclpy
 from rclpy.action import get_action_server_names_and_types_by_node

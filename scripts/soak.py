@@ -1,7 +1,9 @@
-"""Soak benchmark: the whole ROS stack as `make demo` runs it (sim, controller, odometry and
-planner as processes, lockstep paced at real time), for many minutes of driving and repeated
-climbs. Prints each node's resident memory slope (target under 1 MB/min) and the message
-rates it heard.
+"""
+Soak benchmark: the whole ROS stack as `make demo` runs it, for many minutes.
+
+Sim, controller, odometry and planner run as processes, lockstep paced at real time, through
+many minutes of driving and repeated climbs. Prints each node's resident memory slope (target
+under 1 MB/min) and the message rates it heard.
 
     scripts/in_ws python scripts/soak.py [--minutes 10] [--domain-id 77]
 
@@ -14,15 +16,16 @@ slope is a least-squares line through the samples after the first ``--warm-up`` 
 from __future__ import annotations
 
 import argparse
+from collections import Counter
 import os
 import sys
 import time
-from collections import Counter
 
-import numpy as np
-import rclpy
+from demo import NODE_PARAMETERS, NODES, stamp_seconds
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
+import numpy as np
+import rclpy
 from rclpy.action import ActionClient
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -33,9 +36,7 @@ from swivel_car_msgs.action import ClimbStep
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ResetSimulation, SpawnObstacle
 from swivel_car_planner.core import capability
-
-from demo import NODE_PARAMETERS, NODES, stamp_seconds
-from swivel_car_stack import start_node, spin_until
+from swivel_car_stack import spin_until, start_node
 
 STEP_DISTANCE = 1.2  # [m] ahead of the front axle after each reset
 SAMPLE_PERIOD = 5.0  # [s] wall between memory samples
@@ -85,6 +86,7 @@ class SoakNode(Node):
 
 
 class Soak:
+
     def __init__(self, args: argparse.Namespace) -> None:
         self.args = args
         os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'

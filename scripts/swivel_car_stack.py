@@ -1,5 +1,8 @@
-"""Run the stack's nodes the way `ros2 run` runs them: the installed executables under
-ros2_ws/install/<pkg>/lib/<pkg>/, each in its own process on a chosen ROS domain.
+"""
+Run the stack's nodes the way `ros2 run` runs them.
+
+The installed executables under ros2_ws/install/<pkg>/lib/<pkg>/, each in its own process on
+a chosen ROS domain.
 
 Used by the demo (scripts/demo.py) and by the tests (through tests/support).
 """
@@ -7,11 +10,11 @@ Used by the demo (scripts/demo.py) and by the tests (through tests/support).
 from __future__ import annotations
 
 import os
+from pathlib import Path
 import signal
 import subprocess
 import tempfile
 import time
-from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
@@ -19,7 +22,7 @@ INSTALL_DIR = Path(os.environ.get('SWIVEL_CAR_INSTALL', REPO_ROOT / 'ros2_ws' / 
 
 
 def ros_environment(domain_id: int) -> dict[str, str]:
-    """The environment for a node process on ``domain_id``, heard only on this host."""
+    """Return the environment for a node process on ``domain_id``, heard only on this host."""
     env = dict(os.environ)
     env['ROS_DOMAIN_ID'] = str(domain_id)
     env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
@@ -46,7 +49,8 @@ def _parameter_argument(name: str, value: Any) -> str:
 
 
 class NodeProcess:
-    """A node executable running in its own process, its output kept in a log file.
+    """
+    A node executable running in its own process, its output kept in a log file.
 
     Parameters
     ----------
@@ -58,6 +62,7 @@ class NodeProcess:
         ``-p name:=value`` overrides.
     params_file : path, optional
         A ``--params-file``.
+
     """
 
     def __init__(self, package: str, executable: str, domain_id: int,
@@ -101,7 +106,7 @@ class NodeProcess:
 
 
 def config_path(package: str, file_name: str) -> Path:
-    """An installed parameter file: share/<package>/config/<file_name>."""
+    """Return an installed parameter file: share/<package>/config/<file_name>."""
     path = INSTALL_DIR / package / 'share' / package / 'config' / file_name
     if not path.is_file():
         raise FileNotFoundError(f'{path} does not exist: build the workspace (make build)')
@@ -110,19 +115,25 @@ def config_path(package: str, file_name: str) -> Path:
 
 def start_node(package: str, executable: str, domain_id: int,
                parameters: Mapping[str, Any]) -> NodeProcess:
-    """An installed node with its package's parameter file
-    (share/<package>/config/<executable>.yaml) and ``parameters`` on top."""
+    """
+    Start an installed node with its package's parameter file and ``parameters`` on top.
+
+    The file is share/<package>/config/<executable>.yaml.
+    """
     return NodeProcess(package, executable, domain_id, parameters,
                        params_file=config_path(package, f'{executable}.yaml'))
 
 
 def lockstep_parameters(executable: str, lockstep_timeout: float,
                         real_time_factor: float = 1.0) -> dict[str, Any]:
-    """Parameters that put ``executable`` into the lockstep chain of docs/architecture.md:
-    the sim waits for the controller's command of each state (at most ``lockstep_timeout``
-    wall seconds), the controller for the planner's command of the state before. The sim is
-    paced at ``real_time_factor`` (0: none) so that nodes outside the chain, publishing
-    cmd_vel, keep up."""
+    """
+    Return the parameters that put ``executable`` into the lockstep chain.
+
+    The chain of docs/architecture.md: the sim waits for the controller's command of each state (at
+    most ``lockstep_timeout`` wall seconds), the controller for the planner's command of the state
+    before. The sim is paced at ``real_time_factor`` (0: none) so that nodes outside the chain,
+    publishing cmd_vel, keep up.
+    """
     if executable == 'sim_node':
         return {'lockstep': True, 'lockstep_timeout': lockstep_timeout,
                 'lockstep_real_time_factor': real_time_factor}
@@ -133,8 +144,11 @@ def lockstep_parameters(executable: str, lockstep_timeout: float,
 
 def spin_until(executor: Any, condition: Callable[[], bool], timeout: float,
                what: str = 'condition') -> None:
-    """Spin ``executor`` until ``condition()`` holds; TimeoutError after ``timeout`` wall
-    seconds (a guard against a hang, not a measurement)."""
+    """
+    Spin ``executor`` until ``condition()`` holds.
+
+    TimeoutError after ``timeout`` wall seconds (a guard against a hang, not a measurement).
+    """
     deadline = time.monotonic() + timeout
     while not condition():
         if time.monotonic() > deadline:

@@ -272,7 +272,7 @@ _FULL_DISK = textwrap.dedent('''
     from swivel_car_bringup.bag import BagWriter, MessageDefinitions
     disk = Path(sys.argv[1])
     bag = BagWriter(disk / 'bag', MessageDefinitions(get_package_share_directory), 1_500_000)
-    bag.open()
+    bag.create()
     bag.add_topic('/big', 'std_msgs/msg/String', [])
     data = b'\\x00\\x01\\x00\\x00' + (100_000).to_bytes(4, 'little') + b'x' * 99_999 + b'\\x00'
     written = 0

@@ -1,5 +1,8 @@
-"""Recording as a rosbag2 bag with MCAP storage (``metadata.yaml`` plus one ``.mcap``), through
-the ``rosbags`` library, ROS-free: the recorder node hands it serialized (CDR) messages.
+"""
+Recording as a rosbag2 bag with MCAP storage (``metadata.yaml`` plus one ``.mcap``).
+
+Through the ``rosbags`` library, ROS-free: the recorder node hands it serialized (CDR)
+messages.
 
 Message definitions are embedded in the file as ``ros2msg`` schemas, the way ``ros2 bag
 record`` writes them, so ``ros2 bag info/play``, Foxglove and any MCAP reader decode the bag
@@ -10,10 +13,10 @@ interface packages install under ``share/<package>/``.
 
 from __future__ import annotations
 
-import os
-import re
 from dataclasses import dataclass
+import os
 from pathlib import Path
+import re
 from typing import Callable, Iterable
 
 from rosbags.interfaces import Nodetype, Qos
@@ -28,13 +31,15 @@ class UnknownTypeError(LookupError):
 
 
 class MessageDefinitions:
-    """Message definitions (``ros2msg`` text) and type hashes (RIHS01) by type name.
+    """
+    Message definitions (``ros2msg`` text) and type hashes (RIHS01) by type name.
 
     Parameters
     ----------
     share_directory : callable
         Package name -> its installed share directory (``ament_index_python``'s
         ``get_package_share_directory``); raises LookupError for an unknown package.
+
     """
 
     def __init__(self, share_directory: Callable[[str], str | Path]) -> None:
@@ -42,14 +47,17 @@ class MessageDefinitions:
         self.typestore = get_typestore(Stores.ROS2_JAZZY)
 
     def definition(self, msgtype: str) -> tuple[str, str]:
-        """(message definition with every nested type, RIHS01 hash) of e.g.
-        'sensor_msgs/msg/JointState'.
+        """
+        Return (message definition with every nested type, RIHS01 hash) of a type.
+
+        The type is named as e.g. 'sensor_msgs/msg/JointState'.
 
         Raises
         ------
         UnknownTypeError
             Neither the type store nor the installed interface files define it (or a type it
             nests).
+
         """
         pending = [msgtype]
         while pending:
@@ -115,7 +123,8 @@ class TopicRecord:
 
 
 class BagWriter:
-    """A rosbag2 bag with MCAP storage, written message by message.
+    """
+    A rosbag2 bag with MCAP storage, written message by message.
 
     Stops writing, and closes the bag so that it stays readable, when the disk holding it has
     less than ``min_free_space`` left (a chunk is kept in memory until 1 MiB, then written with
@@ -137,6 +146,7 @@ class BagWriter:
     ------
     ValueError
         ``path`` exists, or ``min_free_space`` is negative.
+
     """
 
     def __init__(self, path: Path, definitions: MessageDefinitions, min_free_space: int,
@@ -158,13 +168,15 @@ class BagWriter:
     def is_open(self) -> bool:
         return self._writer is not None
 
-    def open(self) -> None:
-        """Create the bag (directory, metadata at close, the .mcap).
+    def create(self) -> None:
+        """
+        Create the bag (directory, metadata at close, the .mcap).
 
         Raises
         ------
         OSError
             The directory cannot be created.
+
         """
         self.path.parent.mkdir(parents=True, exist_ok=True)
         writer = Writer(self.path, version=BAG_VERSION, storage_plugin=StoragePlugin.MCAP)
@@ -172,12 +184,14 @@ class BagWriter:
         self._writer = writer
 
     def add_topic(self, topic: str, msgtype: str, qos: list[Qos]) -> None:
-        """Register a topic before its first message.
+        """
+        Register a topic before its first message.
 
         Raises
         ------
         UnknownTypeError
             No definition for ``msgtype``.
+
         """
         msgdef, rihs01 = self._definitions.definition(msgtype)
         assert self._writer is not None, 'open() first'
@@ -185,8 +199,11 @@ class BagWriter:
             topic, msgtype, msgdef=msgdef, rihs01=rihs01, offered_qos_profiles=qos)
 
     def write(self, topic: str, timestamp: int, data: bytes) -> bool:
-        """Append one serialized message received at ``timestamp`` [ns]; False once writing
-        has stopped (then ``stopped`` says why)."""
+        """
+        Append one serialized message received at ``timestamp`` [ns].
+
+        Returns False once writing has stopped (then ``stopped`` says why).
+        """
         if self.stopped is not None or self._writer is None:
             return False
         free = self._free_space(self.path)
@@ -210,14 +227,17 @@ class BagWriter:
                              '`mcap recover` reads it')
 
     def close(self) -> list[TopicRecord]:
-        """Write the index and metadata.yaml; returns what each topic holds. Safe to call
-        twice.
+        """
+        Write the index and metadata.yaml; return what each topic holds.
+
+        Safe to call twice.
 
         Raises
         ------
         OSError
             The index could not be written (the disk is full): the .mcap is readable only
             by a reader that scans it (``mcap recover``).
+
         """
         writer, self._writer = self._writer, None
         if writer is None:

@@ -1,5 +1,7 @@
-"""In-process stack benchmark: one climb of a step, its wall time and real-time factor, and
-each core's cost per control period.
+"""
+In-process stack benchmark: one climb of a step.
+
+Measures its wall time and real-time factor, and each core's cost per control period.
 
     python -m swivel_car_bringup.benchmark [--height 0.04] [--distance 1.0]
 
@@ -13,9 +15,8 @@ from __future__ import annotations
 import argparse
 import time
 
-from swivel_car_planner.core import ClimbRequest, make_plan
-
 from swivel_car_bringup.inprocess import InProcessStack
+from swivel_car_planner.core import ClimbRequest, make_plan
 
 _CORES = (('controller', 'SwivelController.step (JointStateController.answer)'),
           ('odometry', 'OffsetTricycleOdometry.update (JointStateOdometry.update)'),
@@ -41,7 +42,7 @@ def main(argv: list[str] | None = None) -> None:
     sim_time = result.outcome.duration if result.outcome else 0.0
     print(f'climb of a {args.height:.3f} m step {args.distance:.2f} m ahead: '
           f'{result.error_code.name} ({result.message})')
-    print(f'  first plan in the process {planning:.2f} s (fills the model\'s caches; later '
+    print(f"  first plan in the process {planning:.2f} s (fills the model's caches; later "
           f'plans reuse them)')
     print(f'  climb: sim time {sim_time:.2f} s, wall {wall:.2f} s, real-time factor '
           f'{sim_time / wall:.1f}x')

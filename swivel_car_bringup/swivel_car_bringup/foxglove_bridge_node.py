@@ -1,8 +1,10 @@
-"""foxglove_bridge_node: a live view of the stack in Foxglove, without RViz or a ROS install
-on the viewing machine. Serves every topic of the graph (as they appear) over Foxglove's
-WebSocket protocol with the Foxglove SDK, as ``ros2msg`` schemas and CDR messages, the way the
-recorder writes them, so a bag and the live view open alike. Adds ``/robot_frames``
-(foxglove.FrameTransforms: odom -> base_link from ``odom`` and every link from
+"""
+foxglove_bridge_node: a live view of the stack in Foxglove.
+
+Needs no RViz or ROS install on the viewing machine. Serves every topic of the graph (as they
+appear) over Foxglove's WebSocket protocol with the Foxglove SDK, as ``ros2msg`` schemas and CDR
+messages, the way the recorder writes them, so a bag and the live view open alike. Adds
+``/robot_frames`` (foxglove.FrameTransforms: odom -> base_link from ``odom`` and every link from
 ``joint_states``), so the 3D panel shows the car from ``robot_description`` where tf2_msgs is
 missing.
 
@@ -13,8 +15,8 @@ from __future__ import annotations
 
 import sys
 
-import foxglove
 from ament_index_python.packages import get_package_share_directory
+import foxglove
 from foxglove import Channel, Schema
 from foxglove.channels import FrameTransformsChannel
 from foxglove.messages import FrameTransform, FrameTransforms, Quaternion, Timestamp, Vector3
@@ -51,8 +53,11 @@ def _foxglove_transform(frame: Frame, stamp) -> FrameTransform:
 
 
 class _Latching(ServerListener):
-    """Sends the last message of a latched (transient local) topic to each new subscriber,
-    as a ROS late subscriber would get it."""
+    """
+    Sender of the last message of a latched (transient local) topic to each new subscriber.
+
+    As a ROS late subscriber would get it.
+    """
 
     def __init__(self) -> None:
         self.last: dict[int, tuple[Channel, bytes, int]] = {}

@@ -1,6 +1,8 @@
-"""The swivel car stack in one process, without ROS: the cores the four nodes wrap, wired in
-the order and on the control period of the ROS lockstep chain (docs/architecture.md, "Timing:
-sim time and lockstep").
+"""
+The swivel car stack in one process, without ROS.
+
+The cores the four nodes wrap, wired in the order and on the control period of the ROS
+lockstep chain (docs/architecture.md, "Timing: sim time and lockstep").
 
 One control period of the ROS chain, and of ``InProcessStack``:
 
@@ -35,22 +37,20 @@ import time
 from typing import Any, Callable, Mapping
 
 import numpy as np
-import yaml
-
-from swivel_car_control.core.controller import ControlOutput, ControllerConfig, SwivelController
+from swivel_car_control.core.controller import ControllerConfig, ControlOutput, SwivelController
 from swivel_car_control.core.joint_states import (
     JointStateController, JointStateOdometry, yaw_quaternion)
 from swivel_car_control.joints import MissingJointError
 from swivel_car_model import description
 from swivel_car_model.description import CarDescription
 from swivel_car_planner.core import (
-    ClimbPlan, ClimbRequest, ClimbStateMachine, Command, ErrorCode, Outcome, PlanError,
-    PlannerConfig, make_plan, validate_request)
-from swivel_car_planner.core import capability, inputs
+    capability, ClimbPlan, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs,
+    make_plan, Outcome, PlanError, PlannerConfig, validate_request)
 from swivel_car_planner.core.sync import InputSync
 from swivel_car_planner.ground_truth import GroundTruth
 from swivel_car_sim.config import PARAMETERS as SIM_PARAMETERS, SimNodeConfig
 from swivel_car_sim.physics import StepSpec, SwivelCarSim
+import yaml
 
 ROBOT_VARIANTS = ('swivel', 'car_like')
 # The joint the controller, odometry and planner steer by, per robot variant (the car-like
@@ -68,13 +68,17 @@ _CLIMB_SLACK = 1.0  # [s] of sim time past the climb's time allowance before giv
 # --- configuration -------------------------------------------------------------------------
 
 def installed_parameters(package: str, executable: str, node: str) -> dict[str, Any]:
-    """The ``ros__parameters`` of ``node`` in the installed parameter file
-    ``share/<package>/config/<executable>.yaml`` (the file the nodes are started with).
+    """
+    Return the ``ros__parameters`` of ``node`` in its installed parameter file.
+
+    The file is ``share/<package>/config/<executable>.yaml`` (the one the nodes are started
+    with).
 
     Raises
     ------
     FileNotFoundError
         The package is not installed (build the workspace: ``make build``).
+
     """
     from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
     try:
@@ -91,8 +95,11 @@ def installed_parameters(package: str, executable: str, node: str) -> dict[str, 
 
 def _dataclass_from(cls: type, values: Mapping[str, Any],
                     defaults: Mapping[str, Any] | None = None, cast: Callable | None = None):
-    """``cls`` from parameter values as the nodes build it: a field's value, else the node's
-    default for it (``defaults``), else the field's default."""
+    """
+    Build ``cls`` from parameter values as the nodes build it.
+
+    A field's value, else the node's default for it (``defaults``), else the field's default.
+    """
     kwargs = {}
     for item in fields(cls):
         default = (defaults or {}).get(item.name, item.default)
@@ -112,7 +119,8 @@ def _check_names(kind: str, overrides: Mapping[str, Any], known: set[str]) -> No
 
 @dataclass(frozen=True)
 class StackConfig:
-    """Every core's configuration, as the nodes build theirs from their parameters.
+    """
+    Every core's configuration, as the nodes build theirs from their parameters.
 
     Attributes
     ----------
@@ -131,6 +139,7 @@ class StackConfig:
     yaw_rate_source : str
         The odometry's ('swivel' or 'rear_wheels').
     odometry_publish_rate : float  # [Hz] of joint_states time
+
     """
 
     sim: SimNodeConfig
@@ -151,7 +160,8 @@ class StackConfig:
                   controller: Mapping[str, Any] | None = None,
                   odometry: Mapping[str, Any] | None = None,
                   planner: Mapping[str, Any] | None = None) -> StackConfig:
-        """The installed parameter files with overrides, as ``-p name:=value`` would give.
+        """
+        Read the installed parameter files with overrides, as ``-p name:=value`` would give.
 
         Parameters
         ----------
@@ -167,6 +177,7 @@ class StackConfig:
         ------
         ValueError
             An unknown parameter name, or a value a node would refuse; the message names it.
+
         """
         if robot_variant not in ROBOT_VARIANTS:
             raise ValueError(f'robot_variant must be one of {ROBOT_VARIANTS}, got '
@@ -226,7 +237,8 @@ class StackConfig:
 
 @dataclass(frozen=True)
 class Trajectory:
-    """Ground truth and actuator commands, one row per control period.
+    """
+    Ground truth and actuator commands, one row per control period.
 
     Attributes
     ----------
@@ -246,6 +258,7 @@ class Trajectory:
         (the sim clamps it to its limit). # [N m]
     drive_speed : numpy.ndarray, shape (n,)
         Drive speed at the wheels the controller commanded for that period. # [rad/s]
+
     """
 
     time: np.ndarray
@@ -260,7 +273,7 @@ class Trajectory:
         return len(self.time)
 
     def between(self, start: float, end: float = math.inf) -> Trajectory:
-        """The rows with ``start <= time <= end`` [s]."""
+        """Return the rows with ``start <= time <= end`` [s]."""
         keep = (self.time >= start) & (self.time <= end)
         return Trajectory(self.time[keep], self.position[keep], self.orientation[keep],
                           self.joint_names, self.joint_positions[keep],
@@ -269,7 +282,8 @@ class Trajectory:
 
 @dataclass(frozen=True)
 class ClimbResult:
-    """What ``InProcessStack.climb`` returns: the planner's answer and what happened.
+    """
+    What ``InProcessStack.climb`` returns: the planner's answer and what happened.
 
     Attributes
     ----------
@@ -291,6 +305,7 @@ class ClimbResult:
     steps : tuple of (float, str)
         The state machine's steps (``state_machine.Step`` names) with the sim time each
         began. # [s]
+
     """
 
     success: bool
@@ -303,8 +318,12 @@ class ClimbResult:
     steps: tuple[tuple[float, str], ...] = ()
 
     def step_window(self, name: str) -> tuple[float, float]:
-        """Sim times [s] from the start of step ``name`` to the start of the next one (or
-        the climb's end); (inf, inf) if the climb never reached it."""
+        """
+        Return the sim times [s] from the start of step ``name`` to the start of the next.
+
+        The window ends at the next step's start or the climb's end; (inf, inf) if the climb
+        never reached the step.
+        """
         for index, (start, step) in enumerate(self.steps):
             if step == name:
                 end = (self.steps[index + 1][0] if index + 1 < len(self.steps)
@@ -316,7 +335,8 @@ class ClimbResult:
 # --- the stack -----------------------------------------------------------------------------
 
 class InProcessStack:
-    """The sim, controller, odometry and planner cores in one process, in lockstep.
+    """
+    The sim, controller, odometry and planner cores in one process, in lockstep.
 
     Parameters
     ----------
@@ -339,6 +359,7 @@ class InProcessStack:
     The stack starts at sim time 0 with the robot at rest at the sim's initial pose, and only
     moves forward in whole control periods. Deterministic: the same calls give the same
     floats, and the same as the ROS nodes in lockstep given the same history.
+
     """
 
     def __init__(self, robot_variant: str = 'swivel', *,
@@ -391,7 +412,7 @@ class InProcessStack:
 
     @property
     def time(self) -> float:
-        """Sim time of the state the next period starts from, as its stamp. # [s]"""
+        """Sim time of the state the next period starts from, as its stamp [s]."""
         nanoseconds = self.sim.steps * self._time_step_ns
         # What builtin_interfaces/Time(sec, nanosec) becomes in the nodes (sec + nanosec*1e-9).
         return nanoseconds // 1_000_000_000 + (nanoseconds % 1_000_000_000) * 1e-9
@@ -404,37 +425,47 @@ class InProcessStack:
     # --- the world ---------------------------------------------------------------------
 
     def reset(self, x: float = 0.0, y: float = 0.0, yaw: float = 0.0) -> None:
-        """Robot at rest at (x [m], y [m], yaw [rad]) in the world, swivel 0, obstacles
-        removed; the controller, odometry (pose 0) and planner start afresh. Sim time goes on.
+        """
+        Put the robot at rest at (x [m], y [m], yaw [rad]) in the world.
+
+        Swivel 0, obstacles removed; the controller, odometry (pose 0) and planner start
+        afresh. Sim time goes on.
 
         Raises
         ------
         ValueError
             A non-finite pose; nothing changes.
+
         """
         self.sim.reset(x, y, yaw, remove_obstacles=True)
         self._start_nodes()
 
     def reset_odometry(self) -> None:
-        """The odometry's pose to the origin and its last twist forgotten, as odometry_node's
-        ``~/reset``; the car does not move."""
+        """
+        Reset the odometry's pose to the origin and forget its last twist.
+
+        As odometry_node's ``~/reset``; the car does not move.
+        """
         self.odometry.odometry.reset()
 
     def spawn_step(self, height: float, distance: float, yaw: float = 0.0,
                    width: float = 3.0, depth: float = 2.0, friction: float = 1.0,
                    name: str = '') -> str:
-        """A rectangular step ahead of the robot, as the sim's ``spawn_obstacle``.
+        """
+        Spawn a rectangular step ahead of the robot, as the sim's ``spawn_obstacle``.
 
         Parameters
         ----------
-        height : float  # [m]
+        height : float
+            Step height. # [m]
         distance : float
             Front axle ground contact to the edge along base_link x. # [m]
         yaw : float
             The edge normal's angle to base_link x. # [rad]
         width, depth : float
             Along the edge and across it. # [m]
-        friction : float  # [1]
+        friction : float
+            Coulomb friction coefficient of the step's surfaces. # [1]
         name : str
             '' for an automatic one.
 
@@ -446,6 +477,7 @@ class InProcessStack:
         ------
         ValueError
             Invalid field, or the step would overlap the robot.
+
         """
         return self.sim.spawn_obstacle(StepSpec(
             name=name, height=height, depth=depth, width=width, distance=distance, yaw=yaw,
@@ -465,7 +497,7 @@ class InProcessStack:
             entry[1] += 1
 
     def _period(self) -> None:
-        """The lockstep chain once (module docstring), from the state of ``time``."""
+        """Run the lockstep chain once (module docstring), from the state of ``time``."""
         t = self.time
         state = self.sim.state()
         names = state.joint_names
@@ -539,22 +571,28 @@ class InProcessStack:
     # --- what users do -----------------------------------------------------------------
 
     def settle(self, duration: float) -> None:
-        """Let ``duration`` [s] of sim time pass (whole control periods) with no new command:
-        the controller holds what it was told last."""
+        """
+        Let ``duration`` [s] of sim time pass (whole control periods) with no new command.
+
+        The controller holds what it was told last.
+        """
         for _ in range(self._periods_for(duration)):
             self._period()
 
     def drive(self, v: float, omega: float, duration: float) -> None:
-        """Drive through the controller's cmd_vel path for ``duration`` [s] of sim time: the
-        command (v [m/s] forward speed of base_link, omega [rad/s] yaw rate) is renewed every
-        control period, stamped with the state's time. Afterwards it is no longer renewed,
-        so the controller's cmd_vel deadman stops the car ``cmd_vel_timeout`` later unless
-        ``drive`` is called again (``drive(0, 0, t)`` stops at once, the swivel held).
+        """
+        Drive through the controller's cmd_vel path for ``duration`` [s] of sim time.
+
+        The command (v [m/s] forward speed of base_link, omega [rad/s] yaw rate) is renewed every
+        control period, stamped with the state's time. Afterwards it is no longer renewed, so the
+        controller's cmd_vel deadman stops the car ``cmd_vel_timeout`` later unless ``drive`` is
+        called again (``drive(0, 0, t)`` stops at once, the swivel held).
 
         Raises
         ------
         ValueError
             A non-finite command or duration.
+
         """
         for name, value in (('v', v), ('omega', omega)):
             if not math.isfinite(value):
@@ -568,8 +606,10 @@ class InProcessStack:
             self._cmd_vel = None
 
     def climb(self, request: ClimbRequest) -> ClimbResult:
-        """Ask the planner to climb: validate, plan, and unless ``plan_only`` run the climb
-        state machine until it ends, as planner_node's climb_step does.
+        """
+        Ask the planner to climb, as planner_node's climb_step does.
+
+        Validate, plan, and unless ``plan_only`` run the climb state machine until it ends.
 
         The climb's first tick is the current state (``time``); the car moves from the next
         control period. When it returns, the car holds still (success: the swivel released
@@ -584,6 +624,7 @@ class InProcessStack:
         Returns
         -------
         ClimbResult
+
         """
         start, first_row = self.time, len(self._rows)
         self._steps = []
@@ -627,8 +668,11 @@ class InProcessStack:
     # --- ground truth --------------------------------------------------------------------
 
     def trajectory(self, rows: slice = slice(None)) -> Trajectory:
-        """The control periods so far (ground truth and the commands of each); ``rows``
-        selects some by index."""
+        """
+        Return the control periods so far (ground truth and the commands of each).
+
+        ``rows`` selects some by index.
+        """
         n = len(self.sim.joint_names)
         selected = self._rows[rows]
         rows = np.array(selected, dtype=float).reshape(len(selected), 1 + 3 + 4 + n + 2)
@@ -642,13 +686,21 @@ class InProcessStack:
                                      state.linear_velocity.tolist())
 
     def front_on_top(self, height: float, tolerance: float = 0.015) -> bool:
-        """Ground truth: the front axle (a wheelbase ahead of base_link) at the height
-        [m] of the step, within ``tolerance`` [m]."""
+        """
+        Tell from the ground truth whether the front axle is on top of the step.
+
+        The front axle (a wheelbase ahead of base_link) at the height [m] of the step, within
+        ``tolerance`` [m].
+        """
         car = self.car
         return self.ground_truth().front_on_top(height, car.r, car.wheelbase, tolerance)
 
     def four_wheels_on_top(self, height: float, tolerance: float = 0.01) -> bool:
-        """Ground truth: the rear axle at the height [m] of the step within ``tolerance``
-        [m], and the car level (so the front axle is up too)."""
+        """
+        Tell from the ground truth whether all four wheels are on top of the step.
+
+        The rear axle at the height [m] of the step within ``tolerance`` [m], and the car
+        level (so the front axle is up too).
+        """
         return self.ground_truth().four_wheels_on_top(height, self.car.r,
                                                       tolerance)

@@ -1,6 +1,9 @@
-"""recorder_node: records every topic of the stack (as they appear on the graph, ``/clock``
-included) into a rosbag2 bag with MCAP storage, each message stamped with its time of receipt
-on the node's clock (sim time with ``use_sim_time``), as ``ros2 bag record`` does.
+"""
+recorder_node: records every topic of the stack into a rosbag2 bag with MCAP storage.
+
+Topics are recorded as they appear on the graph, ``/clock`` included, each message stamped
+with its time of receipt on the node's clock (sim time with ``use_sim_time``), as ``ros2 bag
+record`` does.
 
 Stopping (SIGINT, SIGTERM) loses nothing the node has received: the callback under way
 finishes (the signal is not raised inside it, where it would drop the message or leave a
@@ -10,10 +13,10 @@ recorder may lag the publishers by many) are written before the bag is closed.
 
 from __future__ import annotations
 
+from pathlib import Path
 import signal
 import sys
 import time
-from pathlib import Path
 
 from ament_index_python.packages import get_package_share_directory
 from rcl_interfaces.msg import ParameterDescriptor
@@ -43,7 +46,7 @@ def _time(duration) -> QosTime:
 
 
 def _offered_qos(publishers) -> list[Qos]:
-    """The publishers' QoS as rosbag2 stores them, so `ros2 bag play` offers the same."""
+    """Return the publishers' QoS as rosbag2 stores them, so `ros2 bag play` offers the same."""
     return [Qos(QosHistory(p.history.value), p.depth, QosReliability(p.reliability.value),
                 QosDurability(p.durability.value), _time(p.deadline), _time(p.lifespan),
                 QosLiveliness(p.liveliness.value), _time(p.liveliness_lease_duration), False)
@@ -75,7 +78,7 @@ class RecorderNode(Node):
         try:
             msg_class = message_class(type_name)
             if not self._bag.is_open:
-                self._bag.open()
+                self._bag.create()
             self._bag.add_topic(topic, type_name, _offered_qos(publishers))
         except (LookupError, UnknownTypeError) as error:
             self.get_logger().error(f'not recording {topic}: {error}')
@@ -97,10 +100,13 @@ class RecorderNode(Node):
             self._stop_reported = True
 
     def drain(self) -> int:
-        """Handle the messages already queued in the subscriptions (``/clock`` included, so
-        that they are stamped with the latest time), as the executor would, one per
-        subscription in turn; the spin has ended. At most a queue's depth each, so that a
-        publisher still going cannot keep the node from closing. Returns how many."""
+        """
+        Handle the messages already queued in the subscriptions; return how many.
+
+        ``/clock`` included, so that they are stamped with the latest time; as the executor
+        would, one per subscription in turn; the spin has ended. At most a queue's depth
+        each, so that a publisher still going cannot keep the node from closing.
+        """
         taken = 0
         budget = {sub: max(sub.qos_profile.depth, 1) for sub in self.subscriptions}
         while budget:
@@ -134,10 +140,14 @@ class RecorderNode(Node):
 
 
 def _stop_quietly(signum, frame) -> None:
-    """Python's part of a SIGINT/SIGTERM: nothing, so that no KeyboardInterrupt lands inside a
-    write. rclpy's handler, which calls this one, shuts the context down and wakes the
-    executor: the spin ends after the callback under way, and destroy_node drains the queues
-    and closes the bag. A second signal interrupts as usual (a stuck close)."""
+    """
+    Do Python's part of a SIGINT/SIGTERM: nothing.
+
+    So that no KeyboardInterrupt lands inside a write. rclpy's handler, which calls this one, shuts
+    the context down and wakes the executor: the spin ends after the callback under way, and
+    destroy_node drains the queues and closes the bag. A second signal interrupts as usual (a stuck
+    close).
+    """
     signal.signal(signal.SIGINT, signal.default_int_handler)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 

@@ -1,8 +1,10 @@
-"""robot_description_node: the robot on the graph, robot_state_publisher's part for machines
-that lack it. The URDF generated from the robot description (the same parameters as every
-node) on ``robot_description`` (std_msgs/String, transient local, so late subscribers get it);
-and, where ``tf2_msgs`` is installed, the fixed joints' frames on ``/tf_static`` and the moving
-joints' frames from ``joint_states`` on ``/tf``.
+"""
+robot_description_node: the robot on the graph.
+
+robot_state_publisher's part for machines that lack it. The URDF generated from the robot
+description (the same parameters as every node) on ``robot_description`` (std_msgs/String,
+transient local, so late subscribers get it); and, where ``tf2_msgs`` is installed, the fixed
+joints' frames on ``/tf_static`` and the moving joints' frames from ``joint_states`` on ``/tf``.
 
 On a full Jazzy install, robot_state_publisher with the installed URDF
 (``share/swivel_car_sim/urdf/swivel_car.urdf``) does the same: run one of the two.
@@ -20,9 +22,9 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 
 from swivel_car_bringup.robot_frames import fixed_frames, Frame, moving_frames, parse_joints
+from swivel_car_model.description import ROBOT_VARIANTS
 from swivel_car_ros.ros_params import declare_description, refuse_runtime_changes, \
     run_node
-from swivel_car_model.description import ROBOT_VARIANTS
 from swivel_car_sim.urdf import build_robot
 
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
@@ -56,7 +58,7 @@ class RobotDescriptionNode(Node):
             from tf2_msgs.msg import TFMessage
         except ImportError as error:
             self.get_logger().warn(
-                f'tf2_msgs is not importable ({error}): NOT publishing the robot\'s frames on '
+                f"tf2_msgs is not importable ({error}): NOT publishing the robot's frames on "
                 '/tf and /tf_static; robot_description is published, and the Foxglove bridge '
                 'computes the frames itself')
             return None

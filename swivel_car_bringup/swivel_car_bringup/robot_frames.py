@@ -1,5 +1,7 @@
-"""The frames of a URDF's links from joint positions, as robot_state_publisher computes them:
-one transform parent link -> child link per joint. ROS-free.
+"""
+The frames of a URDF's links from joint positions, as robot_state_publisher computes them.
+
+One transform parent link -> child link per joint. ROS-free.
 
 Used where robot_state_publisher is not installed: by ``robot_description_node`` for /tf and
 /tf_static, and by the Foxglove bridge, which sends the frames to the 3D view itself.
@@ -7,10 +9,10 @@ Used where robot_state_publisher is not installed: by ``robot_description_node``
 
 from __future__ import annotations
 
-import math
-import xml.etree.ElementTree as ElementTree
 from dataclasses import dataclass
+import math
 from typing import Mapping
+import xml.etree.ElementTree as ElementTree
 
 import numpy as np
 
@@ -19,7 +21,8 @@ MOVING = ('revolute', 'continuous', 'prismatic')
 
 @dataclass(frozen=True)
 class Joint:
-    """One URDF joint.
+    """
+    One URDF joint.
 
     Attributes
     ----------
@@ -31,6 +34,7 @@ class Joint:
         Its orientation, quaternion (x, y, z, w).
     axis : numpy.ndarray
         Unit joint axis in the child frame.
+
     """
 
     name: str
@@ -72,12 +76,14 @@ def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def parse_joints(urdf: str) -> list[Joint]:
-    """The joints of a URDF document.
+    """
+    Parse the joints of a URDF document.
 
     Raises
     ------
     ValueError
         Not a URDF robot, or a joint without parent or child.
+
     """
     try:
         robot = ElementTree.fromstring(urdf)
@@ -104,7 +110,7 @@ def parse_joints(urdf: str) -> list[Joint]:
 
 
 def joint_frame(joint: Joint, position: float = 0.0) -> Frame:
-    """The transform parent -> child of ``joint`` at ``position`` [rad or m]."""
+    """Return the transform parent -> child of ``joint`` at ``position`` [rad or m]."""
     translation, rotation = joint.xyz, joint.rotation
     if joint.kind in ('revolute', 'continuous'):
         half = position / 2.0
@@ -118,11 +124,11 @@ def joint_frame(joint: Joint, position: float = 0.0) -> Frame:
 
 
 def fixed_frames(joints: list[Joint]) -> list[Frame]:
-    """The frames of the fixed joints (robot_state_publisher's /tf_static)."""
+    """Return the frames of the fixed joints (robot_state_publisher's /tf_static)."""
     return [joint_frame(j) for j in joints if j.kind not in MOVING]
 
 
 def moving_frames(joints: list[Joint], positions: Mapping[str, float]) -> list[Frame]:
-    """The frames of the moving joints named in ``positions`` (its /tf)."""
+    """Return the frames of the moving joints named in ``positions`` (its /tf)."""
     return [joint_frame(j, positions[j.name]) for j in joints
             if j.kind in MOVING and j.name in positions]

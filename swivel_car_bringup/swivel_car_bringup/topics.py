@@ -1,5 +1,8 @@
-"""Subscribing to whatever the graph offers, as ``ros2 bag record -a`` does: shared by the
-recorder and the Foxglove bridge."""
+"""
+Subscribing to whatever the graph offers, as ``ros2 bag record -a`` does.
+
+Shared by the recorder and the Foxglove bridge.
+"""
 
 from __future__ import annotations
 
@@ -17,13 +20,17 @@ QUEUE_DEPTH = 1000  # [messages] a burst the subscriber may fall behind by witho
 
 
 def message_class(type_name: str) -> type:
-    """The Python class of e.g. 'sensor_msgs/msg/JointState' or an action's
+    """
+    Return the Python class of a message type.
+
+    The type is named as e.g. 'sensor_msgs/msg/JointState' or an action's
     'swivel_car_msgs/action/ClimbStep_FeedbackMessage'.
 
     Raises
     ------
     LookupError
         Not importable.
+
     """
     try:
         package, kind, name = type_name.split('/')
@@ -40,8 +47,11 @@ def message_class(type_name: str) -> type:
 
 
 def subscription_qos(publishers: Iterable[TopicEndpointInfo]) -> QoSProfile:
-    """A QoS that hears every publisher and gets what a transient local one keeps: reliable
-    and transient local only when all publishers offer it (rosbag2's adaptive QoS)."""
+    """
+    Return a QoS that hears every publisher and gets what a transient local one keeps.
+
+    Reliable and transient local only when all publishers offer it (rosbag2's adaptive QoS).
+    """
     profiles = [info.qos_profile for info in publishers]
     reliable = bool(profiles) and all(
         p.reliability == ReliabilityPolicy.RELIABLE for p in profiles)
@@ -54,9 +64,12 @@ def subscription_qos(publishers: Iterable[TopicEndpointInfo]) -> QoSProfile:
 
 
 class TopicWatcher:
-    """Calls ``on_topic(topic, type_name, publishers)`` once for each topic that appears on
-    the graph with a publisher, checked every ``period`` wall seconds (sim time may stand
-    still). A topic with several types is reported once in the log and left out.
+    """
+    Watcher that calls ``on_topic(topic, type_name, publishers)`` once for each new topic.
+
+    Each topic that appears on the graph with a publisher, checked every ``period`` wall
+    seconds (sim time may stand still). A topic with several types is reported once in the
+    log and left out.
 
     Parameters
     ----------
@@ -67,6 +80,7 @@ class TopicWatcher:
     topics : iterable of str
         Only these (fully qualified names); empty: every topic but ``excluded``.
     excluded : iterable of str
+
     """
 
     def __init__(self, node: Node, on_topic: Callable[[str, str, list], None], period: float,

@@ -1,4 +1,5 @@
-"""Timings of the model library, a benchmark and not a test.
+"""
+Timings of the model library, a benchmark and not a test.
 
 ``python -m swivel_car_model.benchmark``
 
@@ -12,9 +13,9 @@ keeps them.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 import tempfile
 import time
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -24,7 +25,8 @@ from swivel_car_model.params import SwivelCarParams
 
 
 def best_of(func: Callable[[], object], repeat: int) -> tuple[float, float]:
-    """Smallest wall time and smallest process CPU time of ``repeat`` calls. # [s]
+    """
+    Return the smallest wall time and smallest process CPU time of ``repeat`` calls [s].
 
     The CPU time is what to compare on a busy machine: the wall time includes waiting for the
     cores.

@@ -7,12 +7,14 @@ from typing import Any
 
 
 def check_finite_number(name: str, value: Any) -> None:
-    """Refuse anything but a finite int or float (a bool is not a number here).
+    """
+    Refuse anything but a finite int or float (a bool is not a number here).
 
     Raises
     ------
     ValueError
         Naming ``name``.
+
     """
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ValueError(f'{name} must be a finite number, got {value!r}')

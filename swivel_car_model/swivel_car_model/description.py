@@ -1,4 +1,5 @@
-"""The robot description: one statement of the swivel car that every part of the stack reads.
+"""
+The robot description: one statement of the swivel car that every part of the stack reads.
 
 Geometry, every mass and where it sits, the drive train, the actuator limits and the swivel
 gains. The inertia about the rear axle (thesis I_s) and the total mass are *derived* from the
@@ -52,8 +53,8 @@ parts at the same places, its frame rod along the ground, so its mass layout is 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, fields, replace
+import math
 from typing import Any, Mapping
 
 import numpy as np
@@ -69,14 +70,18 @@ WHEEL_LINKS = ('rear_left_wheel', 'rear_right_wheel', 'front_left_wheel', 'front
 
 
 def described(default: Any, description: str) -> Any:
-    """A dataclass field whose ``metadata['description']`` (with its unit) is also its ROS
-    parameter's description."""
+    """
+    Make a dataclass field with a description.
+
+    Its ``metadata['description']`` (with its unit) is also its ROS parameter's description.
+    """
     return field(default=default, metadata={'description': description})
 
 
 @dataclass(frozen=True)
 class CarDescription:
-    """The swivel car as built: geometry, mass layout, drive train, actuators, gains.
+    """
+    The swivel car as built: geometry, mass layout, drive train, actuators, gains.
 
     Each field's metadata ``description`` (with its unit) is also its ROS parameter's.
 
@@ -84,6 +89,7 @@ class CarDescription:
     ------
     ValueError
         A field is of the wrong type, not finite or not physical; the message names it.
+
     """
 
     l: float = described(0.25, 'T column length, axle centre to apex [m]')
@@ -92,7 +98,7 @@ class CarDescription:
     r: float = described(0.075, 'wheel radius [m]')
     wheel_width: float = described(0.03, 'wheel tread width [m]')
     max_swivel_angle: float = described(math.pi / 2,
-                                     'mechanical swivel joint limit, symmetric [rad]')
+                                        'mechanical swivel joint limit, symmetric [rad]')
     swivel_limit: float = described(
         1.4, 'largest |swivel angle| commanded (controller set point, planner command), at '
         'most max_swivel_angle; the controller lowers it further to keep the tip-over rule '
@@ -138,13 +144,16 @@ class CarDescription:
 
     @classmethod
     def from_values(cls, values: Mapping[str, Any]) -> 'CarDescription':
-        """Build from parameter values (missing ones take their default); an integer where
-        a float is declared counts as that float.
+        """
+        Build from parameter values (missing ones take their default).
+
+        An integer where a float is declared counts as that float.
 
         Raises
         ------
         ValueError
             Unknown name, wrong type or value; the message names the parameter.
+
         """
         known = {item.name: item for item in fields(cls)}
         unknown = sorted(set(values) - set(known))
@@ -159,7 +168,7 @@ class CarDescription:
         return cls(**converted)
 
     def replace(self, **changes: Any) -> 'CarDescription':
-        """A copy with ``changes`` (validated)."""
+        """Return a copy with ``changes`` (validated)."""
         return replace(self, **changes)
 
     # --- derived quantities ---------------------------------------------------------------
@@ -169,8 +178,11 @@ class CarDescription:
     apex = SwivelCarParams.apex
 
     def parts(self, variant: str = 'swivel') -> list['Part']:
-        """The rigid pieces of the robot with their masses and inertias, in base_link at
-        rest; ``variant`` is 'swivel' or 'car_like'."""
+        """
+        Return the rigid pieces of the robot with their masses and inertias.
+
+        In base_link at rest; ``variant`` is 'swivel' or 'car_like'.
+        """
         if variant not in ROBOT_VARIANTS:
             raise ValueError(f'robot_variant must be one of {ROBOT_VARIANTS}, got {variant!r}')
         zero = np.zeros(3)
@@ -198,34 +210,37 @@ class CarDescription:
         return parts
 
     def wheel_centres(self) -> list[np.ndarray]:
-        """Wheel centres in base_link at rest: rear left, rear right, front left, front
-        right. # [m]"""
+        """
+        Wheel centres in base_link at rest [m].
+
+        Rear left, rear right, front left, front right.
+        """
         wb = self.wheelbase
         return [np.array([0.0, self.h, 0.0]), np.array([0.0, -self.h, 0.0]),
                 np.array([wb, self.h, 0.0]), np.array([wb, -self.h, 0.0])]
 
     @property
     def mass(self) -> float:
-        """Total mass. # [kg]"""
+        """Total mass [kg]."""
         return sum(part.mass for part in self.parts())
 
     @property
     def com(self) -> np.ndarray:
-        """Centre of mass in base_link at rest. # [m]"""
+        """Centre of mass in base_link at rest [m]."""
         return combine(self.parts())[1]
 
     @property
     def com_fraction(self) -> float:
-        """Centre of mass along the wheelbase, 0 at the rear axle, 1 at the front. # [1]"""
+        """Centre of mass along the wheelbase, 0 at the rear axle, 1 at the front [1]."""
         return float(self.com[0]) / self.wheelbase
 
     @property
     def inertia_about_rear_axle(self) -> float:
-        """Moment of inertia about the rear axle's line (thesis I_s). # [kg m^2]"""
+        """Moment of inertia about the rear axle's line (thesis I_s) [kg m^2]."""
         return inertia_about_y_axis(self.parts())
 
     def model_params(self) -> SwivelCarParams:
-        """The thesis model's parameter set for this robot (mass and I_s derived)."""
+        """Return the thesis model's parameter set for this robot (mass and I_s derived)."""
         parts = self.parts()
         return SwivelCarParams(
             l=self.l, h=self.h, phi=self.phi, r=self.r,
@@ -241,7 +256,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
 
 @dataclass(frozen=True)
 class Part:
-    """A rigid piece of the robot: its shape, mass and inertia, in base_link at rest.
+    """
+    A rigid piece of the robot: its shape, mass and inertia, in base_link at rest.
 
     Attributes
     ----------
@@ -256,6 +272,7 @@ class Part:
         x, y, z edges).
     size : tuple of float  # [m]
     axis : numpy.ndarray  # [1]
+
     """
 
     name: str
@@ -270,7 +287,7 @@ class Part:
     @classmethod
     def rod(cls, name: str, link: str, mass: float, radius: float, start: np.ndarray,
             end: np.ndarray) -> 'Part':
-        """A solid cylinder from ``start`` to ``end`` [m] of ``radius`` [m]."""
+        """Make a solid cylinder from ``start`` to ``end`` [m] of ``radius`` [m]."""
         axis = np.asarray(end, dtype=float) - start
         length = float(np.linalg.norm(axis))
         a = axis / length
@@ -283,7 +300,7 @@ class Part:
     @classmethod
     def box(cls, name: str, link: str, mass: float, size: np.ndarray,
             centre: np.ndarray) -> 'Part':
-        """A solid box of edges ``size`` [m] centred at ``centre`` [m], base_link axes."""
+        """Make a solid box of edges ``size`` [m] centred at ``centre`` [m], base_link axes."""
         sx, sy, sz = size
         inertia = np.diag([sy ** 2 + sz ** 2, sx ** 2 + sz ** 2, sx ** 2 + sy ** 2]) * mass / 12.0
         return cls(name, link, float(mass), np.asarray(centre, dtype=float), inertia, 'box',
@@ -302,6 +319,6 @@ def combine(parts: list[Part]) -> tuple[float, np.ndarray, np.ndarray]:
 
 
 def inertia_about_y_axis(parts: list[Part]) -> float:
-    """I_yy of ``parts`` about the y axis through base_link. # [kg m^2]"""
+    """Return I_yy of ``parts`` about the y axis through base_link [kg m^2]."""
     return float(sum(p.inertia[1, 1] + p.mass * (p.com[0] ** 2 + p.com[2] ** 2)
                      for p in parts))

@@ -1,6 +1,8 @@
-"""Dynamics of the swivel car: swivel-joint torque and energy, the car-like baseline, and the
-planar model with nonholonomic constraints.
+"""
+Dynamics of the swivel car: swivel torque, car-like baseline, planar nonholonomic model.
 
+Swivel-joint torque and energy, the car-like baseline, and the planar model with
+nonholonomic constraints.
 Three models (thesis II.C, II.D and IV.A), each derived again; corrections to the thesis are
 listed in docs/thesis_reproduction.md.
 
@@ -52,9 +54,9 @@ listed in docs/thesis_reproduction.md.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import functools
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -106,7 +108,8 @@ def _lift_profile(p: SwivelCarParams) -> CubicSpline:
 
 
 def front_swivel_inertia(p: SwivelCarParams) -> float:
-    """Inertia of the front wheels about the swivel axis, ``2 m_w h^2``. # [kg m^2]
+    """
+    Return the inertia of the front wheels about the swivel axis, ``2 m_w h^2`` [kg m^2].
 
     Not in the thesis' model, whose generalized inertia ``I_s theta1'^2`` vanishes where the
     lift angle peaks (the equation of motion is singular there).
@@ -115,12 +118,13 @@ def front_swivel_inertia(p: SwivelCarParams) -> float:
 
 
 def swivel_generalized_inertia(p: SwivelCarParams, theta2: float) -> float:
-    """``J = I_s (d theta1 / d theta2)^2 + 2 m_w h^2``: inertia seen by the swivel. # [kg m^2]"""
+    """Return ``J = I_s (d theta1 / d theta2)^2 + 2 m_w h^2``, the swivel's inertia [kg m^2]."""
     return p.inertia * kinematics.lift_angle_derivative(p, theta2) ** 2 + front_swivel_inertia(p)
 
 
 def swivel_gravity_torque(p: SwivelCarParams, theta2: float) -> float:
-    """Swivel torque that holds the lifted body still: ``m g l cos(theta1 + phi/2) theta1'``.
+    """
+    Swivel torque that holds the lifted body still: ``m g l cos(theta1 + phi/2) theta1'``.
 
     Odd in ``theta2`` (the potential has a V-shaped minimum at ``theta2 = 0``). # [N m]
     """
@@ -147,15 +151,19 @@ def simulate_swivel_move(p: SwivelCarParams, theta2_target: float, theta2_start:
                          duration: float = 15.0, samples: int = 1501,
                          stop_when_settled: bool = False,
                          max_rate: float = math.inf) -> SwivelMoveResult:
-    """Swivel joint driven by the PID from rest at ``theta2_start`` towards a command that
-    steps to ``theta2_target`` (the thesis' move), or ramps there at ``max_rate`` (the
-    controller's set-point rate limiter).
+    """
+    Simulate the swivel joint driven by the PID from rest towards a target.
+
+    The joint starts at ``theta2_start``; the command steps to ``theta2_target`` (the thesis'
+    move), or ramps there at ``max_rate`` (the controller's set-point rate limiter).
 
     The target and start must lie on the same side of zero (a move through zero switches the
     steering wheel; split it into two moves). Gains are ``p.kp, p.ki, p.kd``.
 
     Parameters
     ----------
+    p : SwivelCarParams
+        The car's model parameters.
     theta2_target, theta2_start : float
         Commanded and initial swivel angle. # [rad]
     duration : float
@@ -166,6 +174,7 @@ def simulate_swivel_move(p: SwivelCarParams, theta2_target: float, theta2_start:
         End early once ``|theta2 - target| < 1e-6 rad`` and ``|theta2_dot| < 1e-6 rad/s``.
     max_rate : float
         Rate limit of the PID's set point; ``inf`` steps it. # [rad/s]
+
     """
     target = _swivel(p, 'theta2_target', theta2_target)
     start = _swivel(p, 'theta2_start', theta2_start)
@@ -245,7 +254,8 @@ def _climb_cost(p: SwivelCarParams, step_height: float,
 
 def climb_torque_energy(p: SwivelCarParams, step_height: float,
                         max_rate: float = math.inf) -> tuple[float, float]:
-    """Predicted peak swivel torque and energy of climbing a step (thesis II.C.2, Fig. 31).
+    """
+    Predicted peak swivel torque and energy of climbing a step (thesis II.C.2, Fig. 31).
 
     Part 1 lifts the wheel: a PID move from 0 to ``kinematics.swivel_for_step``, over
     ``_CLIMB_DURATION`` (the PID's integral must first wind up to the holding torque); the
@@ -264,6 +274,7 @@ def climb_torque_energy(p: SwivelCarParams, step_height: float,
     ------
     ValueError
         NaN, negative or out-of-reach step height.
+
     """
     return _climb_cost(p, _finite('step_height', step_height), float(max_rate))
 
@@ -307,8 +318,12 @@ class CrankClimbResult:
 
 
 def _crank_geometry(c: CarLikeParams, theta_w: np.ndarray):
-    """Body pitch alpha_b (eq. 108), the centre of mass' height above the step edge, and the
-    derivatives of alpha_b, x and y with respect to the crank angle."""
+    """
+    Return the body pitch, the centre of mass' height above the edge and their derivatives.
+
+    Body pitch alpha_b (eq. 108), the centre of mass' height above the step edge, and the
+    derivatives of alpha_b, x and y with respect to the crank angle.
+    """
     alpha = np.arcsin((c.wheel_radius * np.sin(theta_w) - c.wheel_radius + c.step_height)
                       / c.body_length)
     d_alpha = c.wheel_radius * np.cos(theta_w) / (c.body_length * np.cos(alpha))
@@ -322,7 +337,8 @@ def _crank_geometry(c: CarLikeParams, theta_w: np.ndarray):
 
 @functools.lru_cache(maxsize=8)
 def _crank_profile(c: CarLikeParams) -> tuple[float, CubicSpline]:
-    """Start angle and a spline of (M, dV/dtheta_w) over the crank angle; M' by its derivative.
+    """
+    Start angle and a spline of (M, dV/dtheta_w) over the crank angle; M' by its derivative.
 
     ``M = m (x'^2 + y'^2) + I_cm alpha'^2`` (eq. 105 with eqs. 103-104), ``V' = m g y'``.
     """
@@ -337,7 +353,8 @@ def _crank_profile(c: CarLikeParams) -> tuple[float, CubicSpline]:
 
 def simulate_car_like_climb(c: CarLikeParams = CarLikeParams(), duration: float = 10.0,
                             samples: int = 1001) -> CrankClimbResult:
-    """The car-like robot lifting its front wheel over the step edge under the P controller.
+    """
+    Simulate the car-like robot lifting its front wheel over the step edge (P controller).
 
     Starts at rest with the wheel touching both the ground and the edge,
     ``sin theta_w0 = (R_w - h_step) / R_w``; the climb is over when the crank reaches the goal
@@ -399,7 +416,8 @@ _MIRROR = np.array([1.0, -1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0])
 
 
 def _profile_at(p: SwivelCarParams, theta2: float, rate: float, side: float):
-    """Profile values and their time derivatives at swivel angle theta2 moving at ``rate``.
+    """
+    Profile values and their time derivatives at swivel angle theta2 moving at ``rate``.
 
     ``side`` (+1 / -1) says which side of zero the move lies on (which wheel steers). The
     spline's cubic pieces are evaluated directly: this runs once per DAE right-hand side.
@@ -568,17 +586,27 @@ def simulate_planar_swivel(p: SwivelCarParams, theta2_from: float = 0.0,
                            theta2_to: float = math.pi / 2, rate: float = 0.05,
                            samples: int = 316, yaw_inertia: float | None = None,
                            rtol: float = 1e-9) -> PlanarResult:
-    """The car, at rest, while the swivel turns at a constant rate (thesis Figs. 36-38).
+    """
+    Simulate the car, at rest, while the swivel turns at a constant rate (Figs. 36-38).
 
     Thesis setting: 0 -> pi/2 at 0.05 rad/s over 31.5 s. The move must not cross zero.
 
     Parameters
     ----------
+    p : SwivelCarParams
+        The car's model parameters.
+    theta2_from, theta2_to : float
+        Initial and final swivel angle. # [rad]
     rate : float
         Magnitude of the swivel rate. # [rad/s]
+    samples : int
+        Number of output samples over the move.
     yaw_inertia : float, optional
         Yaw inertia of the body about its mass point; default a uniform plate of the
         footprint. # [kg m^2]
+    rtol : float
+        Relative tolerance of the integrator.
+
     """
     start = _swivel(p, 'theta2_from', theta2_from)
     end = _swivel(p, 'theta2_to', theta2_to)
@@ -595,7 +623,8 @@ def simulate_planar_swivel(p: SwivelCarParams, theta2_from: float = 0.0,
 def simulate_planar_coast(p: SwivelCarParams, theta2: float, velocity: tuple[float, float, float],
                           duration: float, samples: int = 201,
                           yaw_inertia: float | None = None, rtol: float = 1e-10) -> PlanarResult:
-    """The unactuated DAE: swivel fixed, an initial push ``(vx, vy, yaw rate)``, free rolling.
+    """
+    Simulate the unactuated DAE: swivel fixed, a push ``(vx, vy, yaw rate)``, free rolling.
 
     The initial velocity is projected onto the constraints (an impulsive start); the kinetic
     energy is then a constant of the motion, since ideal nonholonomic constraints do no work.
@@ -608,8 +637,11 @@ def simulate_planar_coast(p: SwivelCarParams, theta2: float, velocity: tuple[flo
 
 @functools.lru_cache(maxsize=16)
 def _drift_from_zero(p: SwivelCarParams) -> CubicSpline:
-    """Pose after a move from rest at 0 to theta2 >= 0, for every theta2 at once: the run
-    0 -> max_swivel_angle passes through each of them."""
+    """
+    Return the pose after a move from rest at 0 to theta2 >= 0, for every theta2 at once.
+
+    The run 0 -> max_swivel_angle passes through each of them.
+    """
     # rtol 1e-8: within 1e-7 m and rad of the default 1e-9, in a fifth of its time (1 s).
     run = simulate_planar_swivel(p, 0.0, p.max_swivel_angle, rate=1.0, samples=_DRIFT_SAMPLES,
                                  rtol=1e-8)
@@ -640,7 +672,8 @@ def _drift(p: SwivelCarParams, theta2_from: float, theta2_to: float) -> tuple[fl
 
 def swivel_pose_drift(p: SwivelCarParams, theta2_from: float,
                       theta2_to: float) -> tuple[float, float, float]:
-    """Pose change of base_link caused by a swivel move from rest (wheels rolling freely).
+    """
+    Pose change of base_link caused by a swivel move from rest (wheels rolling freely).
 
     Rate independent (see the module docstring); the pose is taken when the swivel reaches
     ``theta2_to`` (after that the car coasts unless its wheels are braked). A move through
@@ -652,6 +685,7 @@ def swivel_pose_drift(p: SwivelCarParams, theta2_from: float,
     -------
     (dx [m], dy [m], dyaw [rad])
         In the base_link frame at the start of the move.
+
     """
     a = round(_swivel(p, 'theta2_from', theta2_from), 6)
     b = round(_swivel(p, 'theta2_to', theta2_to), 6)

@@ -1,4 +1,5 @@
-"""Regenerate the thesis' model figures and the reproduction table.
+"""
+Regenerate the thesis' model figures and the reproduction table.
 
 ``python -m swivel_car_model.figures --out docs/figures [--doc docs/thesis_reproduction.md]``
 writes ``fig18.png`` ... ``fig61.png`` (matplotlib, Agg) and the markdown table of the thesis'
@@ -11,19 +12,18 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import math
-import time
 from pathlib import Path
+import time
 from typing import Callable
 
 import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+
+from swivel_car_model import climbing, dynamics, kinematics, planar
+from swivel_car_model.params import SwivelCarParams
 
 matplotlib.use('Agg')
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from swivel_car_model import climbing, dynamics, kinematics, planar  # noqa: E402
-from swivel_car_model.params import SwivelCarParams  # noqa: E402
-
 P = SwivelCarParams()
 PHIS = [math.pi / 12, math.pi / 6, math.pi / 4, math.pi / 3, 5 * math.pi / 12]
 SWIVEL = np.linspace(0.0, math.pi / 2, 301)
@@ -461,9 +461,12 @@ HAND_WRITTEN = 'Written by hand (`python -m swivel_car_model.figures` does not w
 
 
 def hand_written_sections(path: Path) -> list[str]:
-    """The lines of each ``## `` section of the existing document at ``path`` whose text
-    starts with ``HAND_WRITTEN`` (measurements in physics, which the model cannot make), so
-    that writing the table again keeps them."""
+    """
+    Return the hand-written sections of the existing document at ``path``.
+
+    The lines of each ``## `` section whose text starts with ``HAND_WRITTEN`` (measurements in
+    physics, which the model cannot make), so that writing the table again keeps them.
+    """
     if not path.exists():
         return []
     kept, section = [], []

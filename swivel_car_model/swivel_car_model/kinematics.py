@@ -1,4 +1,5 @@
-"""Kinematics of the swivel car: lift constraint, steering, contact point, step clearance.
+"""
+Kinematics of the swivel car: lift constraint, steering, contact point, step clearance.
 
 Frames (REP-103). All positions are in the *level* ``base_link`` frame: origin at the middle of
 the rear axle at wheel-centre height, x forward, y left, z up, not pitched with the body. The
@@ -47,9 +48,9 @@ With ``cx = cos(phi/2)``, ``sx = sin(phi/2)``, ``s = |sin theta2|``, ``c2 = cos 
 from __future__ import annotations
 
 import bisect
+from dataclasses import dataclass
 import functools
 import math
-from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Union
 
@@ -93,7 +94,7 @@ def _check_swivel(p: SwivelCarParams, theta2: ArrayLike) -> np.ndarray:
 
 
 def _lift_residual(p: SwivelCarParams, theta1, s, xp):
-    """Lift constraint residual f(theta1, s) and its partials (df/dtheta1, df/ds). # [m]"""
+    """Return the lift residual f(theta1, s) [m] and its partials (df/dtheta1, df/ds)."""
     cx, sx = math.cos(p.phi / 2.0), math.sin(p.phi / 2.0)
     c1, s1 = xp.cos(theta1), xp.sin(theta1)
     cb, sb = c1 * cx + s1 * sx, s1 * cx - c1 * sx  # cos, sin of beta = theta1 - phi/2
@@ -130,7 +131,8 @@ def _newton_lift(p: SwivelCarParams, s, theta1, xp):
 
 
 def _lift_from_s(p: SwivelCarParams, s, theta1=None, xp=_NP):
-    """Physical root theta1 of the lift constraint for s = |sin theta2|.
+    """
+    Physical root theta1 of the lift constraint for s = |sin theta2|.
 
     Starts from ``theta1`` if given, else from the cached table (itself started from the
     ``r = 0`` closed form, which selects the root continuous from theta1(0) = 0), then Newton.
@@ -149,7 +151,8 @@ def _as_output(arr: np.ndarray, like: np.ndarray) -> ArrayLike:
 
 
 def lift_angle(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLike:
-    """Lift angle: nose-up pitch of the rear T and central body about the rear axle.
+    """
+    Lift angle: nose-up pitch of the rear T and central body about the rear axle.
 
     Parameters
     ----------
@@ -167,13 +170,15 @@ def lift_angle(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLike:
     ------
     ValueError
         NaN / inf or out-of-range ``theta2``, or no contact solution (non-physical geometry).
+
     """
     t2 = _check_swivel(p, theta2)
     return _as_output(_lift_from_s(p, np.abs(np.sin(t2))), t2)
 
 
 def lift_angle_derivative(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLike:
-    """``d theta1 / d theta2`` by implicit differentiation of the lift constraint. # [1]
+    """
+    Return ``d theta1 / d theta2`` by implicit differentiation of the lift constraint [1].
 
     Odd in ``theta2``. ``theta1`` grows like ``|theta2|`` from zero, so the derivative jumps
     at ``theta2 = 0``; there the right-hand limit is returned.
@@ -187,7 +192,8 @@ def lift_angle_derivative(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLike:
 
 
 def steering_angle(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLike:
-    """Steering angle of the steering wheel as a function of the swivel angle.
+    """
+    Steering angle of the steering wheel as a function of the swivel angle.
 
     The heading of the steering wheel's rolling direction (its shaft projected on the ground,
     turned by -90 deg) relative to base_link's x axis: ``atan2(sin theta2 sin(theta1 - phi/2),
@@ -199,6 +205,7 @@ def steering_angle(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLike:
         Signed steering angle, positive = turning left (counter-clockwise seen from above),
         in ``[-pi/2, pi/2]``. Odd in ``theta2``; for ``phi > 0`` and ``theta2 > 0`` it is
         negative (turning right). # [rad]
+
     """
     t2 = _check_swivel(p, theta2)
     theta1 = _lift_from_s(p, np.abs(np.sin(t2)))
@@ -231,12 +238,13 @@ def _steering_table(p: SwivelCarParams) -> _SteeringTable:
 
 
 def max_steering_angle(p: SwivelCarParams) -> float:
-    """Largest |steering angle| reachable monotonically from ``theta2 = 0``. # [rad]"""
+    """Return the largest |steering angle| reachable monotonically from ``theta2 = 0`` [rad]."""
     return float(_steering_table(p).magnitude[-1])
 
 
 def swivel_for_steering(p: SwivelCarParams, steering: ArrayLike) -> ArrayLike:
-    """Swivel angle giving a wanted steering angle (inverse of :func:`steering_angle`).
+    """
+    Swivel angle giving a wanted steering angle (inverse of :func:`steering_angle`).
 
     Works for both signs of ``phi``: the sign of the result follows the sign conventions of
     the module (for ``phi > 0`` a left turn needs ``theta2 < 0``). Linear interpolation in a
@@ -246,6 +254,8 @@ def swivel_for_steering(p: SwivelCarParams, steering: ArrayLike) -> ArrayLike:
 
     Parameters
     ----------
+    p : SwivelCarParams
+        The car's model parameters.
     steering : float or array
         Wanted steering angle, positive = left, ``|steering| <= max_steering_angle(p)``. # [rad]
 
@@ -258,6 +268,7 @@ def swivel_for_steering(p: SwivelCarParams, steering: ArrayLike) -> ArrayLike:
     ------
     ValueError
         NaN / inf, or ``|steering|`` beyond the reachable range.
+
     """
     table = _steering_table(p)
     limit = table.magnitude_list[-1]
@@ -307,7 +318,8 @@ def _newton_polish_steering(p, theta2, theta1, magnitude, sign, xp):
 
 
 def contact_point(p: SwivelCarParams, theta2: ArrayLike) -> tuple[ArrayLike, ArrayLike]:
-    """Ground contact point of the steering wheel (thesis eqs. 8-10, derived directly).
+    """
+    Ground contact point of the steering wheel (thesis eqs. 8-10, derived directly).
 
     The lowest point of the tilted steering wheel, ``C - r (e_z - a_z a) / |e_z - a_z a|``
     with ``C`` its centre and ``a`` its shaft direction; its height is ``-r`` by the lift
@@ -318,6 +330,7 @@ def contact_point(p: SwivelCarParams, theta2: ArrayLike) -> tuple[ArrayLike, Arr
     (x, y) : floats or arrays
         In the level base_link frame. At ``theta2 = 0``: ``(wheelbase, -h)``; for
         ``theta2 > 0`` the right front wheel, ``y < 0``; mirrored for ``theta2 < 0``. # [m]
+
     """
     t2 = _check_swivel(p, theta2)
     s = np.abs(np.sin(t2))
@@ -347,7 +360,8 @@ def _lowest_height(p: SwivelCarParams, s, theta1):
 
 
 def lifted_wheel_lowest_height(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLike:
-    """Height of the lowest rim point of the lifted front wheel above the ground.
+    """
+    Height of the lowest rim point of the lifted front wheel above the ground.
 
     ``2 h |sin theta2| cos(theta1 - phi/2)``: the thesis' eqs. 14-16 replaced by the exact
     result (both front wheels share the shaft direction, so their lowest points differ by
@@ -357,6 +371,7 @@ def lifted_wheel_lowest_height(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLi
     -------
     float or array
         ``>= 0``; the left wheel's for ``theta2 > 0``, the right one's for ``theta2 < 0``. # [m]
+
     """
     t2 = _check_swivel(p, theta2)
     s = np.abs(np.sin(t2))
@@ -365,7 +380,8 @@ def lifted_wheel_lowest_height(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLi
 
 @dataclass(frozen=True)
 class KinematicState:
-    """Everything the kinematics gives for a swivel angle, computed in one pass.
+    """
+    Everything the kinematics gives for a swivel angle, computed in one pass.
 
     Fields are floats for a scalar ``theta2``, else arrays of its shape.
     """
@@ -392,7 +408,8 @@ def kinematic_state(p: SwivelCarParams, theta2: ArrayLike) -> KinematicState:
 
 
 def tip_over_margin(p: SwivelCarParams, theta1: ArrayLike) -> ArrayLike:
-    """Thesis eq. 72 as a margin: ``pi/2 - phi/2 - theta1``. # [rad]
+    """
+    Return thesis eq. 72 as a margin: ``pi/2 - phi/2 - theta1`` [rad].
 
     The apex (mass point C_m) stays ahead of the rear axle while this is positive.
     """
@@ -403,7 +420,8 @@ def tip_over_margin(p: SwivelCarParams, theta1: ArrayLike) -> ArrayLike:
 
 
 def interference_margin(p: SwivelCarParams, theta1: ArrayLike) -> ArrayLike:
-    """Thesis eq. 75 as a margin: ``l_p - h_p``. # [m]
+    """
+    Return thesis eq. 75 as a margin: ``l_p - h_p`` [m].
 
     ``l_p = 2 l cos(phi/2) cos(theta1)`` is the ground projection of the body (eq. 73) and
     ``h_p = h |sin(phi/2 - theta1)|`` the backward ground projection of the steering wheel's
@@ -441,7 +459,8 @@ def _step_table(p: SwivelCarParams, respect_tip_over: bool) -> _StepTable:
 
 def max_scalable_step(p: SwivelCarParams,
                       respect_tip_over: bool = True) -> tuple[float, float]:
-    """Highest step the lifted front wheel can clear, and the swivel angle that does it.
+    """
+    Highest step the lifted front wheel can clear, and the swivel angle that does it.
 
     The lowest-point height rises with ``|theta2|`` until it peaks or the joint limit; with
     ``respect_tip_over`` it also stops where eq. 72 would be violated (the apex passing
@@ -451,6 +470,7 @@ def max_scalable_step(p: SwivelCarParams,
     -------
     (height [m], theta2 [rad])
         ``theta2 >= 0`` (lifts the left wheel; use ``-theta2`` for the right one).
+
     """
     table = _step_table(p, bool(respect_tip_over))
     if len(table.theta2) < 2:
@@ -460,12 +480,18 @@ def max_scalable_step(p: SwivelCarParams,
 
 def swivel_for_step(p: SwivelCarParams, step_height: ArrayLike,
                     respect_tip_over: bool = True) -> ArrayLike:
-    """Smallest swivel angle whose lifted wheel clears ``step_height``.
+    """
+    Smallest swivel angle whose lifted wheel clears ``step_height``.
 
     Parameters
     ----------
+    p : SwivelCarParams
+        The car's model parameters.
     step_height : float or array
         Step height above the ground, ``0 <= step_height <= max_scalable_step(p)[0]``. # [m]
+    respect_tip_over : bool
+        Stop the reachable range where eq. 72 would be violated (see
+        :func:`max_scalable_step`).
 
     Returns
     -------
@@ -476,6 +502,7 @@ def swivel_for_step(p: SwivelCarParams, step_height: ArrayLike,
     ------
     ValueError
         NaN / inf, negative, or a step out of reach.
+
     """
     heights = _check_finite('step_height', step_height)
     if np.any(heights < 0.0):
@@ -495,7 +522,8 @@ def swivel_for_step(p: SwivelCarParams, step_height: ArrayLike,
 
 
 def dh_transform(theta: ArrayLike, d: ArrayLike, a: ArrayLike, alpha: ArrayLike) -> np.ndarray:
-    """Standard Denavit-Hartenberg link transform ``Rz(theta) Tz(d) Tx(a) Rx(alpha)``.
+    """
+    Return the standard Denavit-Hartenberg link transform ``Rz(theta) Tz(d) Tx(a) Rx(alpha)``.
 
     Returns an array of shape ``(..., 4, 4)`` broadcast over the inputs.
     """
@@ -521,7 +549,8 @@ _THESIS_TO_BASE = np.array([[1.0, 0.0, 0.0, 0.0],
 
 @dataclass(frozen=True)
 class DHFrames:
-    """Frames of the thesis' Table 1 chain in the level base_link frame, each ``(..., 4, 4)``.
+    """
+    Frames of the thesis' Table 1 chain in the level base_link frame, each ``(..., 4, 4)``.
 
     ``o1``: foot of the perpendicular from the rear axle onto the swivel axis (z along the
     swivel axis, towards the front axle). ``o2``: front axle centre. ``o3``: centre of the right
@@ -537,7 +566,8 @@ class DHFrames:
 
 def forward_kinematics(p: SwivelCarParams, theta2: ArrayLike,
                        theta1: ArrayLike | None = None) -> DHFrames:
-    """Forward kinematics through the DH chain of thesis Table 1.
+    """
+    Forward kinematics through the DH chain of thesis Table 1.
 
     Table 1: joint 1 ``(theta_T1 + phi/2 - pi/2, 0, l sin phi, -pi/2)``, joint 2
     ``(theta2, l + l cos phi, 0, -pi/2)``, joint 3 ``(theta3, h, 0, 0)`` with
@@ -545,10 +575,13 @@ def forward_kinematics(p: SwivelCarParams, theta2: ArrayLike,
 
     Parameters
     ----------
+    p : SwivelCarParams
+        The car's model parameters.
     theta2 : float or array
         Swivel angle. # [rad]
     theta1 : float or array, optional
         Lift angle (nose up); default: the lift constraint's :func:`lift_angle`. # [rad]
+
     """
     t2 = _check_swivel(p, theta2)
     t1 = lift_angle(p, t2) if theta1 is None else _check_finite('theta1', theta1)

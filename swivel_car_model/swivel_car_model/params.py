@@ -1,4 +1,5 @@
-"""The swivel car's geometry, masses and swivel PID gains: one validated parameter object.
+"""
+The swivel car's geometry, masses and swivel PID gains: one validated parameter object.
 
 Defaults are thesis Table 2 (with r in centimetres: Table 2 prints "7.5 m").
 
@@ -11,8 +12,8 @@ apex (the central body), the front axle lies ``wheelbase`` ahead, each axle carr
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, fields
+import math
 
 import numpy as np
 
@@ -21,7 +22,8 @@ from swivel_car_model.checks import check_finite_number
 
 @dataclass(frozen=True)
 class SwivelCarParams:
-    """Geometry, inertia and swivel gains of a swivel car.
+    """
+    Geometry, inertia and swivel gains of a swivel car.
 
     Parameters
     ----------
@@ -57,6 +59,7 @@ class SwivelCarParams:
     ------
     ValueError
         A field is not finite or not physical; the message names the field.
+
     """
 
     l: float = 0.25  # [m]
@@ -103,23 +106,26 @@ class SwivelCarParams:
 
     @property
     def wheelbase(self) -> float:
-        """Rear axle to front axle at zero swivel, ``2 l cos(phi/2)``. # [m]"""
+        """Rear axle to front axle at zero swivel, ``2 l cos(phi/2)`` [m]."""
         return 2.0 * self.l * math.cos(self.phi / 2.0)
 
     @property
     def apex(self) -> np.ndarray:
-        """Apex (central body, where the columns meet) in base_link at rest. # [m]"""
+        """Apex (central body, where the columns meet) in base_link at rest [m]."""
         return np.array([self.l * math.cos(self.phi / 2.0), 0.0,
                          self.l * math.sin(self.phi / 2.0)])
 
     @property
     def front_axle(self) -> np.ndarray:
-        """Front axle centre in base_link at rest. # [m]"""
+        """Front axle centre in base_link at rest [m]."""
         return np.array([self.wheelbase, 0.0, 0.0])
 
     @property
     def swivel_axis(self) -> np.ndarray:
-        """Unit vector of the swivel joint's axis in base_link at rest: along the front
-        column from the apex to the front axle. Positive swivel angles turn right-handed
-        about it. # [1]"""
+        """
+        Return the unit vector of the swivel joint's axis in base_link at rest [1].
+
+        Along the front column from the apex to the front axle. Positive swivel angles turn
+        right-handed about it.
+        """
         return np.array([math.cos(self.phi / 2.0), 0.0, -math.sin(self.phi / 2.0)])

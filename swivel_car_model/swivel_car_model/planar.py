@@ -1,4 +1,5 @@
-"""Planar motion of the swivel car: a tricycle with a variable offset steering wheel.
+"""
+Planar motion of the swivel car: a tricycle with a variable offset steering wheel.
 
 Thesis II.E (eqs. 45-71) models the car seen from above as a tricycle whose single steering
 wheel sits at an offset contact point that moves with the swivel angle. The printed equations
@@ -77,7 +78,8 @@ def _finite(name: str, value: float) -> float:
 
 def offset_tricycle_yaw_rate(v: float, a: float, b: float, a_dot: float, b_dot: float,
                              delta: float) -> float:
-    """Yaw rate of a tricycle whose steering wheel touches the ground at a moving offset point.
+    """
+    Yaw rate of a tricycle whose steering wheel touches the ground at a moving offset point.
 
     Parameters
     ----------
@@ -100,6 +102,7 @@ def offset_tricycle_yaw_rate(v: float, a: float, b: float, a_dot: float, b_dot: 
     ValueError
         An input is not finite, or the steering wheel rolls straight towards (or away from)
         the rear axle middle, where its constraint does not fix omega.
+
     """
     for name, value in (('v', v), ('a', a), ('b', b), ('a_dot', a_dot), ('b_dot', b_dot),
                         ('delta', delta)):
@@ -118,7 +121,8 @@ def _yaw_rate(v: float, a: float, b: float, a_dot: float, b_dot: float, delta: f
 
 
 def _geometry_arrays(p: SwivelCarParams, u: np.ndarray) -> tuple[np.ndarray, ...]:
-    """(a, b, delta, da/dtheta2, db/dtheta2, dtheta1/dtheta2) at swivel angles ``u >= 0``.
+    """
+    Return (a, b, delta, da/dtheta2, db/dtheta2, dtheta1/dtheta2) at swivel angles ``u >= 0``.
 
     The derivatives are taken for the wheel in contact at ``u``: differences on the positive
     side (where the model's contact point is one wheel's up to and including zero), so no
@@ -136,10 +140,13 @@ def _geometry_arrays(p: SwivelCarParams, u: np.ndarray) -> tuple[np.ndarray, ...
             (ys[2 * n:] - ys[n:2 * n]) / width, (lift[n:] - lift[:n]) / width)
 
 
-def _geometry(p: SwivelCarParams, theta2: float) -> tuple[float, float, float, float, float,
-                                                           float]:
-    """(a, b, delta, da/dtheta2, db/dtheta2, dtheta1/dtheta2) at ``theta2`` (see
-    ``_geometry_arrays``)."""
+def _geometry(p: SwivelCarParams,
+              theta2: float) -> tuple[float, float, float, float, float, float]:
+    """
+    Return (a, b, delta, da/dtheta2, db/dtheta2, dtheta1/dtheta2) at ``theta2``.
+
+    See ``_geometry_arrays``.
+    """
     sign = -1.0 if theta2 < 0.0 else 1.0
     a, b, delta, da, db, dlift = (float(column[0]) for column in
                                   _geometry_arrays(p, np.array([abs(theta2)])))
@@ -156,11 +163,13 @@ def _check_swivel(p: SwivelCarParams, theta2: float) -> float:
 
 def body_twist(p: SwivelCarParams, theta2: float, theta2_rate: float,
                rear_wheel_rate: float) -> tuple[float, float]:
-    """Planar twist of base_link from the measured joints.
+    """
+    Return the planar twist of base_link from the measured joints.
 
     Parameters
     ----------
     p : SwivelCarParams
+        The car's model parameters.
     theta2 : float
         Swivel angle. # [rad]
     theta2_rate : float
@@ -178,6 +187,7 @@ def body_twist(p: SwivelCarParams, theta2: float, theta2_rate: float,
     ValueError
         Non-finite input, theta2 beyond the joint limit, or the singular swivel angle at which
         the steering wheel's axle line passes through base_link.
+
     """
     theta2 = _check_swivel(p, theta2)
     theta2_rate = _finite('theta2_rate', theta2_rate)
@@ -189,12 +199,14 @@ def body_twist(p: SwivelCarParams, theta2: float, theta2_rate: float,
 
 
 def curvature_for_swivel(p: SwivelCarParams, theta2: float) -> float:
-    """Steady path curvature of base_link, omega / v, at a constant swivel angle.
+    """
+    Steady path curvature of base_link, omega / v, at a constant swivel angle.
 
     Returns
     -------
     float
         Curvature, positive turning left. # [1/m]
+
     """
     theta2 = _check_swivel(p, theta2)
     a, b, delta, _, _, _ = _geometry(p, theta2)
@@ -203,8 +215,11 @@ def curvature_for_swivel(p: SwivelCarParams, theta2: float) -> float:
 
 @functools.lru_cache(maxsize=16)
 def _curvature_table(p: SwivelCarParams, limit: float) -> tuple[np.ndarray, np.ndarray, bool]:
-    """|curvature| sampled over [0, limit] (strictly increasing), for inverting it fast, and
-    whether positive swivel angles turn left (from the geometry, not a guess)."""
+    """
+    Tabulate |curvature| over [0, limit] (strictly increasing) for inverting it fast.
+
+    Also returns whether positive swivel angles turn left (from the geometry, not a guess).
+    """
     angles = np.linspace(0.0, limit, _TABLE_SIZE)
     xs, ys = kinematics.contact_point(p, angles)
     delta = np.asarray(kinematics.steering_angle(p, angles))
@@ -220,7 +235,8 @@ def _curvature_table(p: SwivelCarParams, limit: float) -> tuple[np.ndarray, np.n
 
 
 def max_curvature(p: SwivelCarParams, swivel_limit: float) -> float:
-    """Largest |curvature| reachable with ``|theta2| <= swivel_limit``. # [1/m]
+    """
+    Return the largest |curvature| reachable with ``|theta2| <= swivel_limit`` [1/m].
 
     The curvature grows monotonically with |theta2|, so it is the curvature at the limit.
     """
@@ -232,7 +248,8 @@ def max_curvature(p: SwivelCarParams, swivel_limit: float) -> float:
 
 def swivel_for_curvature(p: SwivelCarParams, curvature: float,
                          swivel_limit: float | None = None) -> float:
-    """Swivel angle that makes base_link follow a path of the given curvature.
+    """
+    Swivel angle that makes base_link follow a path of the given curvature.
 
     Interpolation in a cached table of the curvature (per parameters and limit), then one
     Newton step on the exact relation: accurate to ~1e-12 rad at the cost of one evaluation,
@@ -241,6 +258,7 @@ def swivel_for_curvature(p: SwivelCarParams, curvature: float,
     Parameters
     ----------
     p : SwivelCarParams
+        The car's model parameters.
     curvature : float
         Wanted curvature, positive turning left. # [1/m]
     swivel_limit : float, optional
@@ -256,6 +274,7 @@ def swivel_for_curvature(p: SwivelCarParams, curvature: float,
     ------
     ValueError
         Non-finite curvature, or one beyond ``max_curvature(p, swivel_limit)``.
+
     """
     curvature = _finite('curvature', curvature)
     if swivel_limit is None:
@@ -279,7 +298,8 @@ def swivel_for_curvature(p: SwivelCarParams, curvature: float,
 
 
 class TabulatedModel:
-    """The planar model for the control cores: per-call scalars in a few microseconds.
+    """
+    The planar model for the control cores: per-call scalars in a few microseconds.
 
     The exact functions above solve the lift constraint by Newton iterations in numpy on
     every call, a few hundred microseconds each; the controller and the odometry call them
@@ -297,6 +317,7 @@ class TabulatedModel:
     Parameters
     ----------
     p : SwivelCarParams
+
     """
 
     def __init__(self, p: SwivelCarParams) -> None:
@@ -329,14 +350,17 @@ class TabulatedModel:
         return i, x - i
 
     def lift_angle(self, theta2: float) -> float:
-        """``kinematics.lift_angle`` for one swivel angle. # [rad] from theta2 [rad]"""
+        """Return ``kinematics.lift_angle`` [rad] for one swivel angle theta2 [rad]."""
         i, f = self._locate(theta2)
         lift = self._lift
         return lift[i] + f * (lift[i + 1] - lift[i])
 
     def geometry(self, theta2: float) -> tuple[float, float, float, float, float, float]:
-        """(a, b, delta, da/dtheta2, db/dtheta2, dtheta1/dtheta2) at ``theta2``, as
-        ``_geometry``. # [m], [m], [rad], [m/rad], [m/rad], [1] from theta2 [rad]"""
+        """
+        Return (a, b, delta, da/dtheta2, db/dtheta2, dtheta1/dtheta2) at ``theta2``.
+
+        As ``_geometry``. # [m], [m], [rad], [m/rad], [m/rad], [1] from theta2 [rad]
+        """
         i, f = self._locate(theta2)
         a0, b0, d0, da0, db0, dl0 = self._rows[i]
         a1, b1, d1, da1, db1, dl1 = self._rows[i + 1]
@@ -347,14 +371,18 @@ class TabulatedModel:
         return a, b, delta, da, db, dlift
 
     def curvature(self, theta2: float) -> float:
-        """``curvature_for_swivel`` for one swivel angle. # [1/m] from theta2 [rad]"""
+        """Return ``curvature_for_swivel`` [1/m] for one swivel angle theta2 [rad]."""
         a, b, delta, _, _, _ = self.geometry(theta2)
         return _yaw_rate(1.0, a, b, 0.0, 0.0, delta)
 
     def body_twist(self, theta2: float, theta2_rate: float,
                    rear_wheel_rate: float) -> tuple[float, float]:
-        """``body_twist``: (v [m/s], omega [rad/s]) from theta2 [rad], theta2_rate [rad/s]
-        and the mean rear wheel joint rate [rad/s]; raises ``ValueError`` as it does."""
+        """
+        Return ``body_twist``: (v [m/s], omega [rad/s]).
+
+        From theta2 [rad], theta2_rate [rad/s] and the mean rear wheel joint rate [rad/s];
+        raises ``ValueError`` as ``body_twist`` does.
+        """
         a, b, delta, da, db, dlift = self.geometry(theta2)
         theta2_rate = _finite('theta2_rate', theta2_rate)
         rear_wheel_rate = _finite('rear_wheel_rate', rear_wheel_rate)
@@ -366,13 +394,16 @@ class TabulatedModel:
         return v, omega
 
     def swivel_for_curvature(self, curvature: float, swivel_limit: float) -> float:
-        """``swivel_for_curvature(p, curvature, swivel_limit)``: the swivel angle [rad] for a
-        path curvature [1/m], positive turning left.
+        """
+        Return the swivel angle [rad] for a path curvature [1/m], positive turning left.
+
+        As ``swivel_for_curvature(p, curvature, swivel_limit)``.
 
         Raises
         ------
         ValueError
             Non-finite curvature, or one beyond the curvature at ``swivel_limit`` [rad].
+
         """
         curvature = _finite('curvature', curvature)
         if curvature == 0.0:
@@ -395,12 +426,13 @@ class TabulatedModel:
 
 @functools.lru_cache(maxsize=8)
 def tabulated_model(p: SwivelCarParams) -> TabulatedModel:
-    """The :class:`TabulatedModel` of ``p``, built once per parameter set (tens of ms)."""
+    """Return the :class:`TabulatedModel` of ``p``, built once per parameter set (tens of ms)."""
     return TabulatedModel(p)
 
 
 def wheel_rate_for_speed(p: SwivelCarParams, v: float) -> float:
-    """Drive rate at the wheels for a forward speed of base_link. # [rad/s]
+    """
+    Return the drive rate at the wheels for a forward speed of base_link [rad/s].
 
     The single drive motor turns both axles' differential carriers at the same rate, the mean
     of each axle's wheel rates; the rear carrier rate times r is base_link's speed.
@@ -409,7 +441,8 @@ def wheel_rate_for_speed(p: SwivelCarParams, v: float) -> float:
 
 
 class OffsetTricycleOdometry:
-    """Pose of base_link in the odometry frame, integrated from the measured joints.
+    """
+    Pose of base_link in the odometry frame, integrated from the measured joints.
 
     Each ``update`` computes the body twist from the new measurement (``body_twist``, from
     the parameters' :class:`TabulatedModel`), then moves along the exact arc of the mean of
@@ -418,6 +451,7 @@ class OffsetTricycleOdometry:
     Parameters
     ----------
     p : SwivelCarParams
+
     """
 
     def __init__(self, p: SwivelCarParams) -> None:
@@ -435,14 +469,15 @@ class OffsetTricycleOdometry:
         self._have_twist = False
 
     def set_pose(self, x: float, y: float, yaw: float) -> None:
-        """Set the pose; the twist is kept. # [m], [m], [rad]"""
+        """Set the pose (x [m], y [m], yaw [rad]); the twist is kept."""
         x, y, yaw = _finite('x', x), _finite('y', y), _finite('yaw', yaw)
         self.x, self.y, self.yaw = x, y, _wrap(yaw)
 
     def update(self, theta2: float, theta2_rate: float, rear_wheel_rate: float,
                dt: float, rear_wheel_rate_difference: float | None = None
                ) -> tuple[float, float]:
-        """Advance by ``dt`` with a new joint measurement.
+        """
+        Advance by ``dt`` with a new joint measurement.
 
         Parameters
         ----------
@@ -465,6 +500,7 @@ class OffsetTricycleOdometry:
         ValueError
             Bad input (see ``body_twist``) or a negative or non-finite dt; the state is
             unchanged.
+
         """
         dt = _finite('dt', dt)
         if dt < 0.0:
@@ -486,7 +522,8 @@ class OffsetTricycleOdometry:
 
 
 def arc_step(v: float, omega: float, yaw: float, dt: float) -> tuple[float, float, float]:
-    """Displacement (dx, dy, dyaw) in the fixed frame along the exact arc of a constant twist.
+    """
+    Displacement (dx, dy, dyaw) in the fixed frame along the exact arc of a constant twist.
 
     # [m], [m], [rad] from v [m/s], omega [rad/s], yaw [rad], dt [s]
     """
@@ -501,6 +538,6 @@ def arc_step(v: float, omega: float, yaw: float, dt: float) -> tuple[float, floa
 
 
 def _wrap(angle: float) -> float:
-    """Angle wrapped to (-pi, pi]. # [rad]"""
+    """Wrap an angle to (-pi, pi] [rad]."""
     wrapped = math.remainder(angle, 2.0 * math.pi)
     return math.pi if wrapped == -math.pi else wrapped

@@ -1,4 +1,5 @@
-"""The trailing axle's climb by traction (not in the thesis, which lifts only the front).
+"""
+The trailing axle's climb by traction (not in the thesis, which lifts only the front).
 
 The swivel lifts the wheels of the leading axle over a step; the trailing axle has no lift of
 its own. Once the leading wheels stand on the top face, the trailing wheels meet the riser and
@@ -44,11 +45,16 @@ def _check(name: str, value: float, low: float = 0.0) -> float:
 
 def trailing_axle_min_com(p: SwivelCarParams, step_height: float, com_height: float,
                           mu: float) -> float:
-    """Smallest centre-of-mass position along the wheelbase (0 at the trailing axle, 1 at the
-    leading one) at which the trailing axle climbs a step by traction (module docstring).
+    """
+    Return the smallest centre-of-mass position at which the trailing axle climbs by traction.
+
+    The position runs along the wheelbase, 0 at the trailing axle, 1 at the leading one; the
+    climb is the one the module docstring describes.
 
     Parameters
     ----------
+    p : SwivelCarParams
+        The car's model parameters.
     step_height : float
         In ``(0, L)``. # [m]
     com_height : float
@@ -61,6 +67,7 @@ def trailing_axle_min_com(p: SwivelCarParams, step_height: float, com_height: fl
     float
         0 where a push alone rolls the trailing wheels onto the edge; above 1 where no mass
         layout lets them climb. # [1]
+
     """
     h = _check('step_height', step_height)
     z_c = _check('com_height', com_height, -math.inf)
@@ -83,8 +90,11 @@ def trailing_axle_min_com(p: SwivelCarParams, step_height: float, com_height: fl
 
 def trailing_axle_limit(p: SwivelCarParams, com_fraction: float, com_height: float,
                         mu: float, resolution: float = 0.001) -> float:
-    """Highest step the trailing axle climbs by traction alone with this mass layout, on a
-    ``resolution`` grid (:func:`trailing_axle_min_com`). # [m]"""
+    """
+    Return the highest step the trailing axle climbs by traction alone [m].
+
+    With this mass layout, on a ``resolution`` grid (:func:`trailing_axle_min_com`).
+    """
     c = _check('com_fraction', com_fraction)
     resolution = _check('resolution', resolution)
     if resolution == 0.0:

@@ -15,7 +15,7 @@ P = SwivelCarParams()
 
 
 def apex_potential(p, theta2):
-    """m g times the apex height above its rest height, from the kinematics. # [J]"""
+    """Return m g times the apex height above its rest height, from the kinematics [J]."""
     theta1 = k.lift_angle(p, theta2)
     return p.mass * d.GRAVITY * p.l * (np.sin(theta1 + p.phi / 2) - math.sin(p.phi / 2))
 
@@ -83,10 +83,10 @@ def test_climb_cost_covers_the_holding_torque_and_twice_the_lift_work():
     assert d.climb_torque_energy(P, 0.0) == (0.0, 0.0)
 
 
-@pytest.mark.parametrize('kwargs', [dict(theta2_target=math.nan), dict(theta2_target=2.0),
-                                    dict(theta2_target=0.3, theta2_start=-0.2),
-                                    dict(theta2_target=0.3, duration=0.0),
-                                    dict(theta2_target=0.3, samples=1)])
+@pytest.mark.parametrize('kwargs', [{'theta2_target': math.nan}, {'theta2_target': 2.0},
+                                    {'theta2_target': 0.3, 'theta2_start': -0.2},
+                                    {'theta2_target': 0.3, 'duration': 0.0},
+                                    {'theta2_target': 0.3, 'samples': 1}])
 def test_swivel_move_bad_input(kwargs):
     with pytest.raises(ValueError):
         d.simulate_swivel_move(P, **kwargs)
@@ -184,9 +184,9 @@ def test_swivel_pose_drift_bad_input(args):
         d.swivel_pose_drift(P, *args)
 
 
-@pytest.mark.parametrize('kwargs', [dict(theta2_from=-0.3, theta2_to=0.3),
-                                    dict(theta2_from=0.3, theta2_to=0.3),
-                                    dict(rate=0.0), dict(rate=math.nan)])
+@pytest.mark.parametrize('kwargs', [{'theta2_from': -0.3, 'theta2_to': 0.3},
+                                    {'theta2_from': 0.3, 'theta2_to': 0.3},
+                                    {'rate': 0.0}, {'rate': math.nan}])
 def test_planar_swivel_bad_input(kwargs):
     with pytest.raises(ValueError):
         d.simulate_planar_swivel(P, **kwargs)

@@ -2,9 +2,9 @@
 
 import math
 
+from hypothesis import given, settings, strategies as st
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
 
 from swivel_car_model import kinematics, planar
 from swivel_car_model.params import SwivelCarParams
@@ -102,9 +102,12 @@ def _drive(odometry, swivel_of_t, wheel_rate_of_t, duration, dt):
 
 
 def test_steering_wheel_never_skids_while_the_swivel_moves():
-    """The pose integrated from body_twist moves the steering wheel's contact point only
-    along its rolling direction (the constraint the model is built on), also while the swivel
-    turns and changes sides through zero."""
+    """
+    Check the steering wheel's contact point moves only along its rolling direction.
+
+    The pose integrated from body_twist keeps the constraint the model is built on, also
+    while the swivel turns and changes sides through zero.
+    """
     odometry = planar.OffsetTricycleOdometry(P)
     dt = 1e-3
     contacts, headings, sides = _drive(odometry, lambda t: 1.2 * math.sin(0.8 * t),

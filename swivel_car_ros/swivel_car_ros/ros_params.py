@@ -1,4 +1,5 @@
-"""ROS glue shared by the nodes: config dataclasses as parameters, the main loop.
+"""
+ROS glue shared by the nodes: config dataclasses as parameters, the main loop.
 
 Parameters the ROS 2 way: each is read-only (``ros2 param set`` prints "Trying to set a
 read-only parameter") unless its node applies it while running (``live_parameters``); a live
@@ -10,8 +11,8 @@ from __future__ import annotations
 import dataclasses
 from typing import Any, Callable, Collection, Mapping, TypeVar
 
-import rclpy
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+import rclpy
 from rclpy.exceptions import ParameterException
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.experimental import EventsExecutor
@@ -21,16 +22,21 @@ from swivel_car_model.description import CarDescription
 
 T = TypeVar('T')
 
+
 def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],
                       given: Mapping[str, Any] | None = None) -> T:
-    """Declare one parameter per field of ``cls`` (but those ``given``, stated elsewhere)
-    and build it from their values; all read-only but the fields ``cls.LIVE`` names (if
-    it has that class attribute), which its node applies while running.
+    """
+    Declare one parameter per field of ``cls`` and build it from their values.
+
+    The fields in ``given`` (stated elsewhere) are not declared. All are read-only but the
+    fields ``cls.LIVE`` names (if it has that class attribute), which its node applies while
+    running.
 
     Raises
     ------
     ValueError
         The dataclass refuses the values; the message names the field.
+
     """
     values = dict(given or {})
     live = getattr(cls, 'LIVE', ())
@@ -50,13 +56,16 @@ def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],
 
 
 def declare_description(node: Node) -> CarDescription:
-    """The robot description as read-only parameters, the same names and defaults in every
-    node (``swivel_car_model.description``).
+    """
+    Declare the robot description as read-only parameters.
+
+    The same names and defaults in every node (``swivel_car_model.description``).
 
     Raises
     ------
     ValueError
         A value the description refuses; the message names the parameter.
+
     """
     return CarDescription.from_values({
         name: node.declare_parameter(
@@ -81,9 +90,13 @@ def refuse_runtime_changes(node: Node, names: set[str]) -> None:
 
 def live_parameters(node: Node, names: Collection[str], check: Callable[[dict[str, Any]], T],
                     apply: Callable[[T], None]) -> None:
-    """Parameters ``names`` apply while the node runs. ``check`` builds what a set of them
-    means (their new values by name) or raises ``ValueError``, which refuses the set with
-    its message as the reason; once set, ``apply`` takes what ``check`` built."""
+    """
+    Make the parameters ``names`` apply while the node runs.
+
+    ``check`` builds what a set of them means (their new values by name) or raises
+    ``ValueError``, which refuses the set with its message as the reason; once set,
+    ``apply`` takes what ``check`` built.
+    """
 
     def changes(parameters: list) -> dict[str, Any]:
         return {p.name: p.value for p in parameters if p.name in names}
@@ -108,8 +121,11 @@ def live_parameters(node: Node, names: Collection[str], check: Callable[[dict[st
 
 def run_node(node_class: type[Node], name: str, args: list[str] | None = None,
              executor_class: Callable[[], Executor] = EventsExecutor) -> int:
-    """The Jazzy main loop for one node; a refused parameter ends it with a clear error, a
-    signal (Ctrl-C, SIGTERM) quietly, also when it lands inside a callback.
+    """
+    Run the Jazzy main loop for one node.
+
+    A refused parameter ends it with a clear error, a signal (Ctrl-C, SIGTERM) quietly, also
+    when it lands inside a callback.
 
     Returns the process exit code (0, or 1 for a configuration error).
     """

@@ -1,4 +1,5 @@
-"""Speed of the sim: ``python -m swivel_car_sim.benchmark [--seconds 5]``.
+"""
+Speed of the sim: ``python -m swivel_car_sim.benchmark [--seconds 5]``.
 
 Prints, from one run on this machine:
 
@@ -29,12 +30,12 @@ import time
 
 from ament_index_python.packages import get_package_prefix
 
+from nav_msgs.msg import Odometry
 import pybullet
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
-from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
 
@@ -49,16 +50,22 @@ TOPICS = ((Clock, '/clock'), (JointState, 'joint_states'), (Imu, 'imu'),
 
 
 def _rates(sim_seconds: float, wall_start: float, cpu_start: float) -> tuple[float, float]:
-    """Real-time factor per wall second and per CPU second of this process (the latter
-    does not depend on what else runs on the machine)."""
+    """
+    Return the real-time factor per wall second and per CPU second of this process.
+
+    The latter does not depend on what else runs on the machine.
+    """
     return (sim_seconds / (time.perf_counter() - wall_start),
             sim_seconds / (time.process_time() - cpu_start))
 
 
 def raw_pybullet_rtf(seconds: float) -> tuple[float, float]:
-    """Sim seconds per wall and CPU second of bare stepSimulation on the same world and URDF
-    (no joint motors: pybullet's velocity motors add solver rows and cost more than the
-    drive train's torques)."""
+    """
+    Measure sim seconds per wall and CPU second of bare stepSimulation.
+
+    On the same world and URDF, with no joint motors: pybullet's velocity motors add solver
+    rows and cost more than the drive train's torques.
+    """
     with SwivelCarSim() as sim:
         steps, start, cpu = 0, time.perf_counter(), time.process_time()
         while time.perf_counter() - start < seconds:
@@ -104,8 +111,12 @@ def _environment(domain: int) -> dict[str, str]:
 
 
 def node_rtf(seconds: float, listener: bool) -> tuple[float, float]:
-    """Sim seconds per wall and per CPU second of the sim node spun in this process (as
-    run_node spins it), optionally with another process subscribed to all its topics."""
+    """
+    Measure sim seconds per wall and per CPU second of the sim node spun in this process.
+
+    It is spun as run_node spins it, optionally with another process subscribed to all its
+    topics.
+    """
     listener = _start_listener(DOMAIN) if listener else None
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=DOMAIN)
@@ -138,7 +149,7 @@ def process_rtf(seconds: float) -> float | None:
     try:
         executable = os.path.join(get_package_prefix('swivel_car_sim'), 'lib', 'swivel_car_sim',
                                   'sim_node')
-    except Exception:  # noqa: BLE001 - not installed: skip this figure
+    except Exception:  # not installed: skip this figure
         return None
     process = subprocess.Popen([executable, '--ros-args', '-p', 'real_time_factor:=0.0'],
                                env=_environment(DOMAIN), stdout=subprocess.DEVNULL,

@@ -1,5 +1,9 @@
-"""The sim node's parameters: one table (name, default, description) and the validated,
-frozen configuration read from it. ROS-free."""
+"""
+The sim node's parameters.
+
+One table (name, default, description) and the validated, frozen configuration read from
+it. ROS-free.
+"""
 
 from __future__ import annotations
 
@@ -43,7 +47,8 @@ PARAMETERS: dict[str, tuple[object, str]] = {
 
 @dataclass(frozen=True)
 class SimNodeConfig:
-    """Everything the sim node reads from its parameters, validated.
+    """
+    Everything the sim node reads from its parameters, validated.
 
     Attributes mirror ``PARAMETERS``; ``physics`` is the SimConfig built from them,
     ``steps_per_period`` the physics steps per control period and ``imu_every`` /
@@ -64,12 +69,14 @@ class SimNodeConfig:
 
     @classmethod
     def from_values(cls, values: dict[str, object]) -> 'SimNodeConfig':
-        """Build from parameter values (missing ones take their default).
+        """
+        Build from parameter values (missing ones take their default).
 
         Raises
         ------
         ValueError
             A value is of the wrong type or out of range; the message names it.
+
         """
         v = {name: values.get(name, default) for name, (default, _) in PARAMETERS.items()}
         for name, (default, _) in PARAMETERS.items():

@@ -1,4 +1,5 @@
-"""RobotState -> ROS messages (thin, no logic beyond field mapping).
+"""
+RobotState -> ROS messages (thin, no logic beyond field mapping).
 
 The node publishes four messages every control period; building them fresh costs more than
 a physics step, so it keeps one message of each type (``StateMessages``) and refills it.
@@ -34,8 +35,11 @@ class StateMessages:
         self.odometry.child_frame_id = 'base_link'
 
     def fill(self, state: RobotState, stamp: Time, imu: bool, odometry: bool) -> None:
-        """Refill the messages (imu and odometry only when asked) with ``state`` at ``stamp``.
-        Ground truth: pose of base_link in ``world``, twist in base_link (child frame)."""
+        """
+        Refill the messages (imu and odometry only when asked) with ``state`` at ``stamp``.
+
+        Ground truth: pose of base_link in ``world``, twist in base_link (child frame).
+        """
         self.clock.clock = stamp
         js = self.joint_state
         js.header.stamp = stamp

@@ -1,4 +1,5 @@
-"""The simulated swivel car: a pybullet world with the robot, its drive train and step obstacles.
+"""
+The simulated swivel car: a pybullet world with the robot, its drive train and step obstacles.
 
 ROS-free. ``SwivelCarSim`` owns one pybullet client (DIRECT unless ``gui``), steps it at a
 fixed ``time_step`` and exposes what a motor driver board and an IMU would: joint states, base
@@ -27,10 +28,10 @@ both wheels in the air, is still well damped; their values are in ``DriveGains``
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 import math
 import os
 import tempfile
-from dataclasses import dataclass, field
 
 import numpy as np
 import pybullet
@@ -49,7 +50,8 @@ URDF_FLAGS = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CY
 
 @dataclass(frozen=True)
 class SimConfig:
-    """Configuration of a SwivelCarSim; validated on construction.
+    """
+    Configuration of a SwivelCarSim; validated on construction.
 
     Parameters
     ----------
@@ -71,6 +73,7 @@ class SimConfig:
         Give the body (columns, axle housings, central body) collision shapes, not only the
         wheels: for a phi < 0 robot, whose belly hangs below the axle line
         (``swivel_car_sim.urdf``). Needs a robot whose body clears the ground at rest.
+
     """
 
     description: CarDescription = field(default_factory=CarDescription)
@@ -93,7 +96,7 @@ class SimConfig:
 
     @property
     def params(self) -> SwivelCarParams:
-        """The model's parameter set of the robot (geometry, derived mass and inertia)."""
+        """Return the model's parameter set of the robot (geometry, derived mass and inertia)."""
         return self.description.model_params()
 
 
@@ -104,7 +107,8 @@ def _require(ok: bool, name: str, value, what: str) -> None:
 
 @dataclass(frozen=True)
 class DriveGains:
-    """Gains of the drive train model (see the module docstring).
+    """
+    Gains of the drive train model (see the module docstring).
 
     Attributes
     ----------
@@ -114,6 +118,7 @@ class DriveGains:
     shaft_damping : float  # [N m s/rad]
     lock_stiffness : float  # [N m/rad] between the wheels of a locked axle
     lock_damping : float  # [N m s/rad]
+
     """
 
     speed_p: float
@@ -125,9 +130,13 @@ class DriveGains:
 
     @classmethod
     def for_robot(cls, params: SwivelCarParams, time_step: float) -> 'DriveGains':
-        """Gains that keep a carrier with both wheels in the air (inertia 2 I_w) stable and
-        well damped, and give the loaded speed loop (the whole car on the rear carrier)
-        a damping ratio near 0.7."""
+        """
+        Make the drive gains for a robot.
+
+        They keep a carrier with both wheels in the air (inertia 2 I_w) stable and well
+        damped, and give the loaded speed loop (the whole car on the rear carrier) a damping
+        ratio near 0.7.
+        """
         wheel_inertia = params.wheel_mass * params.r ** 2 / 2.0  # [kg m^2] about the axle
         free_carrier = 2.0 * wheel_inertia
         loaded_carrier = params.mass * params.r ** 2 + 4.0 * wheel_inertia
@@ -145,8 +154,11 @@ class DriveGains:
 
 @dataclass(frozen=True)
 class StepSpec:
-    """A rectangular step, relative to base_link at the time of the request
-    (see swivel_car_msgs/msg/StepObstacle.msg for the meaning of each field)."""
+    """
+    A rectangular step, relative to base_link at the time of the request.
+
+    See swivel_car_msgs/msg/StepObstacle.msg for the meaning of each field.
+    """
 
     name: str
     height: float  # [m]
@@ -177,7 +189,8 @@ class StepSpec:
 
 @dataclass(frozen=True)
 class RobotState:
-    """What the sensors and the ground truth report at one instant.
+    """
+    What the sensors and the ground truth report at one instant.
 
     Attributes
     ----------
@@ -191,6 +204,7 @@ class RobotState:
     linear_velocity : numpy.ndarray  # [m/s] base_link origin velocity, in base_link
     angular_velocity : numpy.ndarray  # [rad/s] in base_link
     linear_acceleration : numpy.ndarray  # [m/s^2] specific force (IMU), in base_link
+
     """
 
     time: float
@@ -206,19 +220,20 @@ class RobotState:
 
     @property
     def yaw(self) -> float:
-        """Heading of base_link about the world z axis. # [rad]"""
+        """Heading of base_link about the world z axis [rad]."""
         x, y, z, w = self.orientation
         return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
     @property
     def pitch(self) -> float:
-        """Pitch of base_link, positive nose down (REP-103 rotation about y). # [rad]"""
+        """Pitch of base_link, positive nose down (REP-103 rotation about y) [rad]."""
         x, y, z, w = self.orientation
         return math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
 
 
 class SwivelCarSim:
-    """A pybullet world holding one swivel car (or car-like baseline) and step obstacles.
+    """
+    A pybullet world holding one swivel car (or car-like baseline) and step obstacles.
 
     Parameters
     ----------
@@ -230,6 +245,7 @@ class SwivelCarSim:
     -----
     Deterministic: the same sequence of calls gives the same states. Sim time only moves
     forward (``reset`` keeps it), so ROS clocks fed from it never jump back.
+
     """
 
     def __init__(self, config: SimConfig | None = None,
@@ -285,35 +301,37 @@ class SwivelCarSim:
 
     @property
     def steps(self) -> int:
-        """Physics steps taken since construction. # [1]"""
+        """Physics steps taken since construction [1]."""
         return self._steps
 
     @property
     def time(self) -> float:
-        """Sim time. # [s]"""
+        """Sim time [s]."""
         return self._steps * self._time_step
 
     def set_command(self, swivel_torque: float, drive_speed: float) -> None:
-        """Take an actuator command (clamped to the limits); it feeds the watchdog.
+        """
+        Take an actuator command (clamped to the limits); it feeds the watchdog.
 
         Raises
         ------
         ValueError
             A field is not finite; the previous command stays.
+
         """
         for name, value in (('swivel_torque', swivel_torque), ('drive_speed', drive_speed)):
             if not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise ValueError(f'{name} must be finite, got {value!r}')
         d = self.description
-        self._swivel_torque = min(d.swivel_torque_limit, max(-d.swivel_torque_limit,
-                                                              float(swivel_torque)))
-        self._drive_speed = min(d.drive_speed_limit, max(-d.drive_speed_limit,
-                                                          float(drive_speed)))
+        self._swivel_torque = min(d.swivel_torque_limit,
+                                  max(-d.swivel_torque_limit, float(swivel_torque)))
+        self._drive_speed = min(d.drive_speed_limit,
+                                max(-d.drive_speed_limit, float(drive_speed)))
         self._command_time = self.time
 
     @property
     def watchdog_tripped(self) -> bool:
-        """True while the last command is older than the watchdog timeout."""
+        """Whether the last command is older than the watchdog timeout."""
         timeout = self._watchdog_timeout
         return timeout > 0.0 and self.time - self._command_time > timeout + 1e-9
 
@@ -367,12 +385,14 @@ class SwivelCarSim:
 
     def reset(self, x: float = 0.0, y: float = 0.0, yaw: float = 0.0,
               remove_obstacles: bool = False) -> None:
-        """Put the robot at rest on the ground at (x, y, yaw), swivel at 0, command zero.
+        """
+        Put the robot at rest on the ground at (x, y, yaw), swivel at 0, command zero.
 
         Raises
         ------
         ValueError
             Non-finite pose, or the robot would overlap an obstacle; nothing changes.
+
         """
         for name, value in (('x', x), ('y', y), ('yaw', yaw)):
             if not isinstance(value, (int, float)) or not math.isfinite(value):
@@ -421,8 +441,11 @@ class SwivelCarSim:
 
     def _base_velocity_world(self) -> tuple[tuple[float, float, float],
                                             tuple[float, float, float]]:
-        """base_link origin velocity and angular velocity in the world frame (floats: it
-        runs twice per ``step``)."""
+        """
+        Return base_link's origin velocity and angular velocity in the world frame.
+
+        As floats: it runs twice per ``step``.
+        """
         client = self._client
         com_pos, com_orn = pybullet.getBasePositionAndOrientation(self._body,
                                                                   physicsClientId=client)
@@ -435,7 +458,7 @@ class SwivelCarSim:
                  linear[2] + wx * dy - wy * dx), angular)
 
     def state(self) -> RobotState:
-        """The sensors and the ground truth now."""
+        """Return the sensors and the ground truth now."""
         states = self._pb.getJointStates(self._body, self._joint_ids)
         pos, orn = self._base_pose()
         rotation = np.array(pybullet.getMatrixFromQuaternion(orn)).reshape(3, 3)
@@ -450,8 +473,11 @@ class SwivelCarSim:
             linear_acceleration=rotation.T @ specific_force)
 
     def wheel_lowest_points(self) -> np.ndarray:
-        """Lowest point height of each wheel's rim circle (thin disc, as the thesis models
-        it), rear left, rear right, front left, front right. # [m]"""
+        """
+        Return the lowest point height of each wheel's rim circle [m].
+
+        A thin disc, as the thesis models it; rear left, rear right, front left, front right.
+        """
         heights = []
         for joint in self._wheel_ids:
             s = self._pb.getLinkState(self._body, joint, computeForwardKinematics=1)
@@ -464,9 +490,12 @@ class SwivelCarSim:
         return np.array(heights)
 
     def body_clearance(self) -> float:
-        """Smallest distance from the body's collision shapes to the ground and the
-        obstacles, 1 m if farther; negative when they touch (penetration). Needs
-        ``SimConfig.body_collision``. # [m]"""
+        """
+        Return the smallest distance from the body's collision shapes to the world [m].
+
+        To the ground and the obstacles, 1 m if farther; negative when they touch
+        (penetration). Needs ``SimConfig.body_collision``.
+        """
         if not self.config.body_collision:
             raise ValueError('body_clearance needs SimConfig(body_collision=True)')
         reach = 1.0  # [m]
@@ -480,9 +509,12 @@ class SwivelCarSim:
 
     def show_state(self, position: np.ndarray, orientation: np.ndarray,
                    joint_positions: dict[str, float]) -> None:
-        """Place the robot at a recorded state without simulating: base_link at
-        ``position`` [m] with ``orientation`` (quaternion x, y, z, w), joints at
-        ``joint_positions`` [rad] (joints not named keep their angle)."""
+        """
+        Place the robot at a recorded state without simulating.
+
+        base_link at ``position`` [m] with ``orientation`` (quaternion x, y, z, w), joints at
+        ``joint_positions`` [rad] (joints not named keep their angle).
+        """
         com_pos, com_orn = pybullet.multiplyTransforms(
             list(position), list(orientation), *self._com_in_link)
         self._pb.resetBasePositionAndOrientation(self._body, com_pos, com_orn)
@@ -493,9 +525,12 @@ class SwivelCarSim:
     def render(self, width: int = 320, height: int = 240,
                target: np.ndarray | None = None, distance: float = 1.4,
                yaw: float = -50.0, pitch: float = -25.0) -> np.ndarray:
-        """An RGB image (height x width x 3, uint8) from pybullet's software renderer, the
-        camera looking at ``target`` [m] (default base_link) from ``distance`` [m],
-        ``yaw`` and ``pitch`` [deg] as in pybullet's debug camera."""
+        """
+        Render an RGB image (height x width x 3, uint8) with pybullet's software renderer.
+
+        The camera looks at ``target`` [m] (default base_link) from ``distance`` [m], ``yaw``
+        and ``pitch`` [deg] as in pybullet's debug camera.
+        """
         if target is None:
             target = self._base_pose()[0]
         view = self._pb.computeViewMatrixFromYawPitchRoll(
@@ -514,13 +549,15 @@ class SwivelCarSim:
         return tuple(self._obstacles)
 
     def spawn_obstacle(self, spec: StepSpec) -> str:
-        """Add a step in front of the robot; returns its name.
+        """
+        Add a step in front of the robot; returns its name.
 
         Raises
         ------
         ValueError
             Invalid field, duplicate name, or the box would overlap the robot; the world is
             unchanged.
+
         """
         spec.validate()
         name = spec.name or self._next_obstacle_name()
@@ -579,12 +616,14 @@ class SwivelCarSim:
             pb.removeBody(probe)
 
     def remove_obstacle(self, name: str) -> None:
-        """Remove the obstacle ``name``; the empty name removes all.
+        """
+        Remove the obstacle ``name``; the empty name removes all.
 
         Raises
         ------
         ValueError
             No obstacle of that name.
+
         """
         if name == '':
             for body in self._obstacles.values():

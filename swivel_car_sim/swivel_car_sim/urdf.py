@@ -1,4 +1,5 @@
-"""URDF of the swivel car (and of a car-like baseline of the same size) from a CarDescription.
+"""
+URDF of the swivel car (and of a car-like baseline of the same size) from a CarDescription.
 
 ROS-free. The robot has one source of truth, ``swivel_car_model.description.CarDescription``:
 its parts (``CarDescription.parts``) become the links' inertials and visuals here, nothing
@@ -18,8 +19,8 @@ and its belly is what meets a step edge first.
 from __future__ import annotations
 
 import argparse
-import math
 from dataclasses import dataclass
+import math
 from pathlib import Path
 
 import numpy as np
@@ -38,12 +39,13 @@ CAR_LIKE_MAX_STEERING = 0.6  # [rad] turntable steering limit of the baseline ca
 # lifted the body 0.03 rad more than the lift constraint. wheel_width still sets the inertia
 # and the visuals.
 TYRE_CONTACT_WIDTH = 0.004  # [m]
-_MATERIALS = {'body': 'body', **{link: 'tyre' for link in WHEEL_LINKS}}
+_MATERIALS = {'body': 'body', **dict.fromkeys(WHEEL_LINKS, 'tyre')}
 
 
 @dataclass(frozen=True)
 class RobotModel:
-    """A generated robot.
+    """
+    A generated robot.
 
     Attributes
     ----------
@@ -61,6 +63,7 @@ class RobotModel:
         Moment of inertia about the rear axle's line (base_link y) at rest. # [kg m^2]
     com : numpy.ndarray
         Centre of mass in base_link at rest. # [m]
+
     """
 
     urdf: str
@@ -83,8 +86,7 @@ def _rpy_z_to(direction: np.ndarray) -> np.ndarray:
 
 
 def _shape(part: Part, origin: np.ndarray) -> str:
-    """The part's <origin> and <geometry> in the frame of a link whose origin is ``origin``
-    [m]."""
+    """Return the part's <origin> and <geometry> in a link frame with origin ``origin`` [m]."""
     centre = part.com - origin
     if part.shape == 'box':
         return (f'<origin xyz="{_fmt(centre)}" rpy="0 0 0"/>'
@@ -130,8 +132,11 @@ def _joint(name: str, kind: str, parent: str, child: str, xyz: np.ndarray,
 
 
 def _wheel_collision(d: CarDescription) -> str:
-    """The wheel's cylinder collision (load with pybullet.URDF_USE_IMPLICIT_CYLINDER, else
-    pybullet makes it a faceted hull)."""
+    """
+    Return the wheel's cylinder collision.
+
+    Load it with pybullet.URDF_USE_IMPLICIT_CYLINDER, else pybullet makes it a faceted hull.
+    """
     return (f'<collision><origin xyz="0 0 0" rpy="{_fmt([math.pi / 2.0, 0.0, 0.0])}"/>'
             f'<geometry><cylinder radius="{d.r:.9g}" '
             f'length="{min(d.wheel_width, TYRE_CONTACT_WIDTH):.9g}"/>'
@@ -141,7 +146,8 @@ def _wheel_collision(d: CarDescription) -> str:
 def build_robot(description: CarDescription, variant: str = 'swivel',
                 max_steering: float = CAR_LIKE_MAX_STEERING,
                 body_collision: bool = False) -> RobotModel:
-    """Generate the URDF of a swivel car or of the car-like baseline.
+    """
+    Generate the URDF of a swivel car or of the car-like baseline.
 
     Parameters
     ----------
@@ -165,6 +171,7 @@ def build_robot(description: CarDescription, variant: str = 'swivel',
     ------
     ValueError
         Unknown variant or max_steering not in (0, pi/2).
+
     """
     if not (math.isfinite(max_steering) and 0.0 < max_steering < math.pi / 2.0):
         raise ValueError(f'max_steering must be in (0, pi/2), got {max_steering!r}')

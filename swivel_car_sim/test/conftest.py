@@ -11,11 +11,14 @@ CONTROL_STEPS = 5  # [1] physics steps per 0.01 s control period
 
 
 class SwivelHold:
-    """Holds the swivel at a set point with a PD at 100 Hz, the way the controller drives
-    the sim (the real controller lives in swivel_car_control; this one only keeps tests
-    independent of it): the description's kp and kd, the set point ramped at ``rate`` as the
-    controller ramps it. A stepped set point rolls the car over once its weight is forward:
-    the swivel overshoots to its joint limit and the rear body rolls onto one wheel."""
+    """
+    A PD at 100 Hz that holds the swivel at a set point, the way the controller drives the sim.
+
+    The real controller lives in swivel_car_control; this one only keeps tests independent of
+    it: the description's kp and kd, the set point ramped at ``rate`` as the controller ramps
+    it. A stepped set point rolls the car over once its weight is forward: the swivel
+    overshoots to its joint limit and the rear body rolls onto one wheel.
+    """
 
     def __init__(self, sim: SwivelCarSim, rate: float = 1.5) -> None:
         self.sim = sim
@@ -24,8 +27,11 @@ class SwivelHold:
         self.set_point: float | None = None  # [rad]
 
     def period(self, swivel_target: float, drive_speed: float) -> RobotState:
-        """Command from the state now, advance one control period; returns the state
-        before the period."""
+        """
+        Command from the state now and advance one control period.
+
+        Returns the state before the period.
+        """
         state = self.sim.state()
         if self.set_point is None:
             self.set_point = state.positions[0]

@@ -9,7 +9,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from swivel_car_msgs.msg import ActuatorCommand
 from swivel_car_msgs.srv import StepSimulation
-from swivel_car_testing import NodeProcess, next_domain_id, spin_until
+from swivel_car_testing import next_domain_id, NodeProcess, spin_until
 
 TIMEOUT = 30.0  # [s] wall guard against a hang
 
