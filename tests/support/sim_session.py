@@ -19,7 +19,7 @@ import rclpy
 from rclpy.action import ActionClient
 from rclpy.executors import SingleThreadedExecutor
 from std_srvs.srv import Empty, SetBool
-from swivel_car_model.params import SwivelCarParams
+from swivel_car_model.description import CarDescription
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
@@ -56,20 +56,27 @@ class SimSession:
     def __init__(self, robot_variant: str = 'swivel',
                  planner_parameters: dict[str, Any] | None = None,
                  planner: bool = True,
-                 sim_parameters: dict[str, Any] | None = None) -> None:
+                 sim_parameters: dict[str, Any] | None = None,
+                 robot_parameters: dict[str, Any] | None = None) -> None:
+        """``robot_parameters``: robot description values for every node (a design file's
+        ``ros__parameters``); unset = the installed configs' description."""
         self.domain_id = next_domain_id()
+        robot = dict(robot_parameters or {})
+        description = CarDescription.from_values(robot)
+        self.wheel_radius = description.r  # [m]
+        self.wheelbase = description.wheelbase  # [m]
         # The car-like baseline steers a turntable joint; the controller drives it the same way.
         joint = {'swivel_joint': 'steering_joint' if robot_variant == 'car_like'
                  else 'swivel_joint'}
         sim_time = {'use_sim_time': True, **joint}
         # In the lockstep chain the planner's climbs do not depend on the machine's load, and
         # nothing outside it drives the car: the sim runs as fast as the chain answers.
-        specs = [('swivel_car_sim', 'sim_node', {'robot_variant': robot_variant}),
-                 ('swivel_car_control', 'controller_node', sim_time),
-                 ('swivel_car_control', 'odometry_node', sim_time)]
+        specs = [('swivel_car_sim', 'sim_node', {'robot_variant': robot_variant, **robot}),
+                 ('swivel_car_control', 'controller_node', {**sim_time, **robot}),
+                 ('swivel_car_control', 'odometry_node', {**sim_time, **robot})]
         if planner:
             specs.append(('swivel_car_planner', 'planner_node',
-                          {**sim_time, **(planner_parameters or {})}))
+                          {**sim_time, **robot, **(planner_parameters or {})}))
         self.processes: list[NodeProcess] = []
         try:
             for package, executable, parameters in specs:
@@ -200,10 +207,6 @@ class SimSession:
     def four_wheels_on_top(self, height: float, tolerance: float = 0.01) -> bool:
         return self.truth is not None and self.truth.four_wheels_on_top(
             height, self.wheel_radius, tolerance)
-
-    # The installed configs' geometry is thesis Table 2, SwivelCarParams' defaults.
-    wheel_radius = SwivelCarParams().r  # [m]
-    wheelbase = SwivelCarParams().wheelbase  # [m]
 
     def close(self) -> list[str]:
         """Stop everything; returns the logs of processes that died on their own."""
