@@ -40,8 +40,7 @@ from swivel_car_stack import spin_until, start_node
 
 STEP_DISTANCE = 1.2  # [m] ahead of the front axle after each reset
 SAMPLE_PERIOD = 5.0  # [s] wall between memory samples
-# (v [m/s], omega [rad/s]) in turn; straight last, so the swivel is back at zero when the
-# sim resets the robot (the controller keeps holding its set point across a reset).
+# (v [m/s], omega [rad/s]) in turn.
 ARCS = ((0.3, 0.5), (0.3, -0.5), (0.0, 0.8), (0.2, 0.0))
 TOPICS = {'joint_states': JointState, 'imu': Imu, 'odom': Odometry,
           'ground_truth/odom': Odometry, 'controller/controller_state': SwivelControllerState,

@@ -13,6 +13,7 @@ from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
+from std_msgs.msg import Header
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
 
 from swivel_car_control.conversions import is_zero_stamp, stamp_to_seconds
@@ -97,6 +98,7 @@ class ControllerNode(Node):
         self.create_subscription(TwistStamped if self._use_stamped else Twist, 'cmd_vel',
                                  self._on_cmd_vel, 10)
         self.create_subscription(SwivelCommand, 'swivel_command', self._on_swivel_command, 10)
+        self.create_subscription(Header, 'sim/reset_event', self._on_sim_reset, 10)
         if self._lockstep_swivel_command:
             self.create_timer(self._lockstep_wait / 4.0, self._on_wait_timer,
                               clock=Clock(clock_type=ClockType.STEADY_TIME))
@@ -169,6 +171,20 @@ class ControllerNode(Node):
                 self.get_logger().info('swivel_command released: cmd_vel steers again')
         if self._pending is not None and not self._must_wait(self._pending):
             self._answer(self._take_pending())
+
+    def _on_sim_reset(self, msg: Header) -> None:
+        t = stamp_to_seconds(msg.stamp)
+        try:
+            self._joint_states.reset(t)
+        except ValueError as error:
+            self.get_logger().warn(f'ignoring sim/reset_event: {error}',
+                                   throttle_duration_sec=1.0)
+            return
+        if self._pending is not None and stamp_to_seconds(self._pending.header.stamp) < t:
+            self._pending = None  # a state of the old world: the sim waits for it no more
+        self.get_logger().info(f'the sim was reset at {t:.3f} s: commands dropped, the swivel '
+                               'held where it is measured then, drive stopped, until a new '
+                               'command')
 
     def _must_wait(self, msg: JointState) -> bool:
         """Lockstep with a stamped swivel_command held: ``msg`` waits for the command that

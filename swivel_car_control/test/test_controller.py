@@ -184,3 +184,37 @@ def test_time_going_back_restarts():
     out = controller.step(0.0, 0.2, 0.0)
     assert out.pid.i_term == 0.0
     assert out.set_point == pytest.approx(0.2)
+
+
+def test_a_world_reset_drops_the_commands_and_holds_the_swivel_measured_after_it():
+    """The sim's ~/reset put the car back at rest with the swivel at 0 while the controller
+    held 0.6 rad: it re-steered to 0.6 (found by the soak)."""
+    controller = make(cmd_vel_timeout=0.0, swivel_command_timeout=0.0)
+    controller.set_cmd_vel(0.2, 0.4, 0.0)
+    run(controller, 0.0, 1.0)
+    controller.set_swivel_command(0.6, 0.0, 2.0, True, 1.0)
+    run(controller, 1.0, 1.0)
+    controller.reset(2.0)
+    assert controller.swivel_command is None
+    # A state from before the reset, still on its way: no restart yet (its swivel is 0.6).
+    before = controller.step(1.995, 0.6, 0.0)
+    assert before.source == SOURCE_HOLD and before.target == 0.6
+    after = controller.step(2.0, 0.0, 0.0)
+    assert after.source == SOURCE_HOLD and after.target == 0.0 and after.set_point == 0.0
+    assert after.swivel_torque == 0.0 and after.drive_speed == 0.0
+    later = run(controller, 2.01, 1.0)
+    assert later.target == 0.0 and later.drive_speed == 0.0
+    controller.set_cmd_vel(0.2, 0.0, 3.01)  # a new command after the reset is obeyed
+    assert run(controller, 3.01, 0.5).drive_speed > 0.0
+    with pytest.raises(ValueError, match='finite'):
+        controller.reset(math.nan)
+
+
+def test_a_command_between_a_reset_and_its_first_state_is_kept():
+    controller = make(cmd_vel_timeout=0.0)
+    controller.set_cmd_vel(0.2, 0.4, 0.0)
+    run(controller, 0.0, 1.0)
+    controller.reset(1.0)
+    controller.set_cmd_vel(0.2, 0.0, 1.0)
+    out = run(controller, 1.0, 0.5, measured=0.0)
+    assert out.source == SOURCE_CMD_VEL and out.drive_speed > 0.0

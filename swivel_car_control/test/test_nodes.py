@@ -11,6 +11,7 @@ from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rclpy.executors import SingleThreadedExecutor
 from sensor_msgs.msg import JointState
+from std_msgs.msg import Header
 from std_srvs.srv import Empty
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import SetPose2D
@@ -173,6 +174,29 @@ def test_swivel_command_and_refusal(controller):
     spin_until(controller.executor,
                lambda: states[-1].source == 'swivel_command', 10.0, 'swivel_command source')
     assert states[-1].target == 0.5
+
+
+def test_a_sim_reset_event_restarts_the_controller_from_the_state_after_it(controller):
+    """sim/reset put the car back with the swivel at 0; the controller went on holding the
+    0.5 rad it held before and turned the swivel back to it (found by the soak)."""
+    reset = controller.probe.create_publisher(Header, 'sim/reset_event', 10)
+    controller.wait_connected(reset)
+    step(controller, 1.0)
+    controller.swivel.publish(SwivelCommand(angle=0.5, drive_speed=1.0, hold=True))
+    for k in range(1, 10):
+        step(controller, 1.0 + 0.01 * k, swivel=0.5)
+    controller.swivel.publish(SwivelCommand(hold=False))
+    held = step(controller, 1.1, swivel=0.5)
+    reset.publish(Header(stamp=joint_state(1.12).header.stamp, frame_id='world'))
+    before = step(controller, 1.11, swivel=0.5)  # a state of the old world, still answered
+    assert before.swivel_torque == held.swivel_torque
+    states = controller.received['controller/controller_state']
+    for k in range(12, 30):
+        command = step(controller, 0.01 * k + 1.0)
+        assert abs(command.swivel_torque) < 1e-9 and command.drive_speed == 0.0
+    spin_until(controller.executor, lambda: states[-1].header.stamp == joint_state(1.29)
+               .header.stamp, 10.0, 'the last state')
+    assert states[-1].source == 'hold' and states[-1].target == 0.0
 
 
 def stamped_swivel_command(t, angle, hold=True):

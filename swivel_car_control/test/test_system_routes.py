@@ -106,9 +106,6 @@ class RouteDriver:
     def drive(self, segments: list[Segment]) -> tuple[Odometry, Odometry, float]:
         """From the origin at rest: drive, then stand for SETTLE. Returns the odometry and
         the ground truth of one moment at the end, and the distance the truth travelled."""
-        # The swivel back to 0 first: the controller would turn a reset swivel back to the
-        # angle it last held.
-        self.run([Segment(1.5, 'swivel', 0.0, 0.0)])
         self.call(self.reset_sim, ResetSimulation.Request(remove_obstacles=True))
         self.wait(0.3, 'the car to settle after the reset')
         self.call(self.reset_odometry, Empty.Request())

@@ -13,6 +13,7 @@ from rcl_interfaces.msg import ParameterDescriptor
 from rosgraph_msgs.msg import Clock as ClockMsg
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, JointState
+from std_msgs.msg import Header
 from std_srvs.srv import SetBool
 from swivel_car_msgs.msg import ActuatorCommand
 from swivel_car_msgs.srv import (RemoveObstacle, ResetSimulation, SpawnObstacle,
@@ -55,11 +56,13 @@ class SimNode(Node):
         self._period_start_wall = self._last_publish_wall = time.monotonic()
         self._next_due_wall = self._period_start_wall  # [s] steady clock of the next paced advance
         self._messages = StateMessages(self.sim.joint_names)
+        self._reset_ns = 0  # [ns] sim time of the first state after the last ~/reset
 
         self._clock_pub = self.create_publisher(ClockMsg, '/clock', 10)
         self._joint_pub = self.create_publisher(JointState, 'joint_states', 10)
         self._imu_pub = self.create_publisher(Imu, 'imu', 10)
         self._odom_pub = self.create_publisher(Odometry, 'ground_truth/odom', 10)
+        self._reset_pub = self.create_publisher(Header, '~/reset_event', 10)
         self.create_subscription(ActuatorCommand, 'actuator_command', self._on_command, 10)
         self.create_service(ResetSimulation, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/set_paused', self._on_set_paused)
@@ -156,6 +159,9 @@ class SimNode(Node):
     # --- callbacks -------------------------------------------------------------------------
 
     def _on_command(self, msg: ActuatorCommand) -> None:
+        computed = Time.from_msg(msg.header.stamp).nanoseconds
+        if 0 < computed < self._reset_ns:
+            return  # it answers a state of the world before the last reset
         if self._stale(msg.header.stamp):
             return
         try:
@@ -228,6 +234,16 @@ class SimNode(Node):
             return response
         response.success = True
         response.message = f'robot at ({request.x}, {request.y}, {request.yaw})'
+        # The reset takes the rest of this control period, with the zero command it set: the
+        # state after it has a stamp of its own, so an answer to a state before it cannot
+        # pass for an answer to it. The event goes out first: a controller that hears it
+        # starts afresh from that state on (docs/architecture.md).
+        self.sim.step(self.config.steps_per_period
+                      - self.sim.steps % self.config.steps_per_period)
+        self._periods += 1
+        self._command_ready = False
+        self._reset_ns = self.sim.steps * self._time_step_ns
+        self._reset_pub.publish(Header(stamp=self._stamp(), frame_id='world'))
         self._period_start_wall = time.monotonic()
         self._publish_state()
         return response

@@ -13,6 +13,7 @@ from builtin_interfaces.msg import Time
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
 from nav_msgs.msg import Odometry
+from std_msgs.msg import Header
 from std_srvs.srv import SetBool
 from swivel_car_msgs.msg import ActuatorCommand, StepObstacle
 from swivel_car_msgs.srv import RemoveObstacle, ResetSimulation, SpawnObstacle, StepSimulation
@@ -252,6 +253,36 @@ def test_spawn_remove_and_reset_services(harness_factory):
     assert not missing.success and 'no obstacle' in missing.message
     assert h.call(RemoveObstacle, 'remove_obstacle', RemoveObstacle.Request(name='')).success
     assert h.sim.sim.obstacle_names == ()
+
+
+def test_reset_announces_the_first_state_of_the_new_world_and_drops_older_commands(
+        harness_factory):
+    """A controller learns of a reset from sim/reset_event, heard before the state it names;
+    that state has a stamp of its own, so the answer to a state before the reset (still on
+    its way) is dropped, not applied to the reset car."""
+    h = harness_factory(lockstep=True, lockstep_timeout=0.0)
+    heard = []
+    h.client.create_subscription(Header, 'sim/reset_event',
+                                 lambda msg: heard.append(('reset', _ns(msg.stamp))), 10)
+    h.client.create_subscription(JointState, 'joint_states',
+                                 lambda msg: heard.append(('state', _ns(msg.header.stamp))), 50)
+    before = _lockstep_run(h, 20)
+    assert before.position[0] > 0.03  # the swivel turned
+    reset = h.call(ResetSimulation, 'reset', ResetSimulation.Request(x=0.5))
+    assert reset.success, reset.message
+    first = 21 * 10**7
+    spin_until(h.executor, lambda: ('state', first) in heard, TIMEOUT, 'the state after it')
+    assert heard.index(('reset', first)) < heard.index(('state', first))
+    after = h.joint_states[-1]
+    assert _ns(after.header.stamp) == first and abs(after.position[0]) < 1e-3
+    h.command(before.header.stamp, swivel_torque=10.0, drive_speed=5.0)
+    for _ in range(20):
+        h.executor.spin_once(timeout_sec=0.01)
+    assert h.call(StepSimulation, 'step', StepSimulation.Request(steps=5)).success
+    spin_until(h.executor, lambda: _ns(h.joint_states[-1].header.stamp) == first + 10**7,
+               TIMEOUT, 'the stepped state')
+    assert h.joint_states[-1].effort[0] == 0.0
+    assert abs(h.joint_states[-1].velocity[1]) < 0.05
 
 
 def test_lockstep_timeout_advances_and_the_watchdog_stops_the_drive(harness_factory):

@@ -151,10 +151,8 @@ class SimSession:
         return future.result()
 
     def reset(self, x: float = 0.0, y: float = 0.0, yaw: float = 0.0) -> None:
-        """Robot back at rest at the pose, swivel at 0, obstacles removed, odometry zeroed."""
-        # The swivel to 0 first: the controller holds the angle a climb left it at and would
-        # turn the reset swivel back to it, moving the car.
-        self.drive_straight(0.0, 1.0)
+        """Robot back at rest at the pose, swivel at 0, obstacles removed, odometry zeroed
+        (the controller starts afresh from the reset state: sim/reset_event)."""
         response = self.call(self.reset_client, ResetSimulation.Request(
             x=x, y=y, yaw=yaw, remove_obstacles=True))
         if not response.success:

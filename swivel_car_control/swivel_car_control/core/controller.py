@@ -152,6 +152,7 @@ class SwivelController:
         self._last_time: float | None = None  # [s]
         self._cmd_vel: tuple[float, float, float] | None = None  # (v, omega, stamp)
         self._swivel_command: SwivelCommandRequest | None = None
+        self._restart_at: float | None = None  # [s] time of a world reset not yet stepped
 
     @property
     def swivel_command(self) -> SwivelCommandRequest | None:
@@ -172,6 +173,23 @@ class SwivelController:
         if fixed:
             raise ValueError(f'{", ".join(fixed)} cannot change while the controller runs')
         self.config = config
+
+    def reset(self, t: float) -> None:
+        """The world was reset at time ``t`` [s] (the sim's ``~/reset``: the car put back at
+        rest, swivel 0): the commands given so far are dropped now, and the first step at
+        ``t`` or later starts afresh from the swivel measured then, held with the drive
+        stopped until a new command comes. Steps of earlier times (states from before the
+        reset, still on their way) go on as before.
+
+        Raises
+        ------
+        ValueError
+            ``t`` is not finite; nothing changes.
+        """
+        if not math.isfinite(t):
+            raise ValueError(f'reset time must be finite, got {t!r}')
+        self._cmd_vel = self._swivel_command = None
+        self._restart_at = float(t)
 
     def set_cmd_vel(self, v: float, omega: float, stamp: float) -> None:
         """Take a velocity command: v [m/s], omega [rad/s], stamp [s] (its time).
@@ -226,8 +244,9 @@ class SwivelController:
 
     def step(self, t: float, measured: float, measured_rate: float) -> ControlOutput:
         """One control period at time ``t`` [s] with the measured swivel angle [rad] and rate
-        [rad/s]. Time going backwards (a sim reset) restarts the controller's memory and drops
-        the commands given before: they belong to the old run.
+        [rad/s]. Time going backwards (a restarted sim) restarts the controller's memory and
+        drops the commands given before: they belong to the old run. So does the first step
+        at or after a ``reset`` time, keeping the commands given since the reset.
 
         The deadmans count in the time of these steps, whatever clock stamped a command: a
         command stamped later than ``t`` (another clock, a /clock far ahead, a runtime
@@ -237,9 +256,13 @@ class SwivelController:
         for name, value in (('t', t), ('measured', measured), ('measured_rate', measured_rate)):
             if not math.isfinite(value):
                 raise ValueError(f'{name} must be finite, got {value!r}')
-        if self._last_time is None or t < self._last_time:
-            if self._last_time is not None:
-                self._cmd_vel = self._swivel_command = None
+        went_back = self._last_time is not None and t < self._last_time
+        if went_back:
+            self._cmd_vel = self._swivel_command = None
+        reset = self._restart_at is not None and (went_back or t >= self._restart_at)
+        if reset:
+            self._restart_at = None
+        if self._last_time is None or went_back or reset:
             self._restart(measured)
             dt = 0.0
         else:

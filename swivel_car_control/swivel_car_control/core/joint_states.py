@@ -44,20 +44,35 @@ class JointStateController:
         self.swivel_joint = swivel_joint
         self._joints = JointReader([swivel_joint])
         self.last_time: float | None = None  # [s] stamp of the last message answered
+        self._reset_at: float | None = None  # [s] time of a world reset not yet answered
+
+    def reset(self, t: float) -> None:
+        """The world was reset at time ``t`` [s]: ``SwivelController.reset``, and the
+        positions read before it are not differenced against the states from ``t`` on.
+
+        Raises
+        ------
+        ValueError
+            ``t`` is not finite; nothing changes.
+        """
+        self.core.reset(t)
+        self._reset_at = t
 
     def answer(self, t: float, names: Sequence[str], positions: Sequence[float],
                velocities: Sequence[float]) -> tuple[JointSample, ControlOutput]:
         """The swivel sample and the control output for the state of time ``t`` [s]
         (positions [rad], velocities [rad/s], in the order of ``names``). Time going back
-        (a sim reset) forgets the previous positions.
+        (a restarted sim) or reaching a ``reset`` time forgets the previous positions.
 
         Raises
         ------
         swivel_car_control.joints.MissingJointError
             No usable swivel reading; nothing was stepped (answer with zero torque and drive).
         """
-        if self.last_time is not None and t < self.last_time:
+        if (self.last_time is not None and t < self.last_time) or (
+                self._reset_at is not None and t >= self._reset_at):
             self._joints.reset()
+            self._reset_at = None
         swivel = self._joints.read(t, names, positions, velocities)[self.swivel_joint]
         self.last_time = t
         return swivel, self.core.step(t, swivel.position, swivel.rate)
