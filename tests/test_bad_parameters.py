@@ -1,7 +1,10 @@
-"""A parameter of the wrong type or value at start ends every node with one [FATAL] line
-naming it, exit code 1 and no traceback (issue 12: before, rclpy's
-InvalidParameterTypeException, and any bad planner value); an integer where a number is due
-is that number."""
+"""
+A bad parameter at start ends every node with one [FATAL] line naming it.
+
+A parameter of the wrong type or value: exit code 1 and no traceback (issue 12: before,
+rclpy's InvalidParameterTypeException, and any bad planner value); an integer where a number
+is due is that number.
+"""
 
 import os
 import subprocess
@@ -13,7 +16,7 @@ from swivel_car_control.controller_node import ControllerNode
 from swivel_car_control.odometry_node import OdometryNode
 from swivel_car_planner.planner_node import PlannerNode
 from swivel_car_sim.sim_node import SimNode
-from swivel_car_testing import REPO_ROOT, next_domain_id
+from swivel_car_testing import next_domain_id, REPO_ROOT
 
 INSTALL = REPO_ROOT / 'ros2_ws' / 'install'
 CASES = [
@@ -37,7 +40,8 @@ def test_a_wrong_type_at_start_is_one_fatal_line_and_exit_1(package, executable,
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
                ROS_DOMAIN_ID=str(next_domain_id()))
     done = subprocess.run(
-        [str(REPO_ROOT / 'scripts' / 'in_ws'), str(INSTALL / package / 'lib' / package / executable),
+        [str(REPO_ROOT / 'scripts' / 'in_ws'),
+         str(INSTALL / package / 'lib' / package / executable),
          '--ros-args', '-p', f'{name}:={value}'],
         env=env, capture_output=True, text=True, timeout=60)
     output = done.stdout + done.stderr

@@ -1,5 +1,8 @@
-"""Every node console script the packages declare is installed where `ros2 run` looks
-(install/<pkg>/lib/<pkg>/), starts as a node, and exits cleanly on SIGINT."""
+"""
+Every node console script the packages declare is installed where `ros2 run` looks.
+
+That is install/<pkg>/lib/<pkg>/; each starts as a node and exits cleanly on SIGINT.
+"""
 
 from __future__ import annotations
 
@@ -8,13 +11,13 @@ import ast
 import pytest
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
-from swivel_car_testing import REPO_ROOT, NodeProcess, executable_path, spin_until
+from swivel_car_testing import executable_path, NodeProcess, REPO_ROOT, spin_until
 
 PYTHON_PACKAGES = sorted(path.parent.name for path in REPO_ROOT.glob('swivel_car_*/setup.py'))
 
 
 def console_scripts(package: str) -> list[str]:
-    """The console script names in ``package``'s setup.py."""
+    """Return the console script names in ``package``'s setup.py."""
     tree = ast.parse((REPO_ROOT / package / 'setup.py').read_text())
     for node in ast.walk(tree):
         if isinstance(node, ast.Dict):

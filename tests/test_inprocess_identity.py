@@ -1,6 +1,8 @@
-"""The in-process stack (swivel_car_bringup.inprocess) is the ROS lockstep run: one climb
-through the installed executables and through InProcessStack gives the same outcome and the
-same ground truth, joint positions and actuator commands in every control period, bit for bit.
+"""
+The in-process stack (swivel_car_bringup.inprocess) is the ROS lockstep run, bit for bit.
+
+One climb through the installed executables and through InProcessStack gives the same outcome
+and the same ground truth, joint positions and actuator commands in every control period.
 
 Why bit for bit can be asked: in lockstep every node acts on the state of one moment, the
 planner's command takes effect exactly one period later, and the in-process stack calls the
@@ -25,16 +27,15 @@ from __future__ import annotations
 
 import time
 
+from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
-from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 from sim_session import SimSession
 from std_srvs.srv import Empty
+from swivel_car_bringup.inprocess import InProcessStack, StackConfig
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand
 from swivel_car_msgs.srv import ClimbStep, StepSimulation
-
-from swivel_car_bringup.inprocess import InProcessStack, StackConfig
 from swivel_car_planner.core import ClimbRequest, ErrorCode
 from swivel_car_sim.config import SimNodeConfig
 
@@ -48,8 +49,7 @@ def _seconds(stamp) -> float:
 
 
 class _Recorder:
-    """Ground truth, joint positions, actuator commands and odometry of the ROS run, by
-    stamp."""
+    """Ground truth, joint positions, actuator commands and odometry of the ROS run, by stamp."""
 
     def __init__(self, session: SimSession) -> None:
         node = session.node
@@ -105,8 +105,11 @@ class _Recorder:
 
 def _ros_climb(session: SimSession, recorder: _Recorder, request: ClimbStep.Request,
                sim: SimNodeConfig):
-    """The climb through the executables, its first tick at a known state; returns the
-    response and that tick's time [s]."""
+    """
+    Climb through the executables, the climb's first tick at a known state.
+
+    Returns the response and that tick's time [s].
+    """
     step_client = session.node.create_client(StepSimulation, 'sim/step')
     controller, planner = session.processes[1], session.processes[3]
     session.spin_until(lambda: all(client.service_is_ready() for client in (

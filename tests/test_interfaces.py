@@ -1,5 +1,9 @@
-"""Every swivel_car_msgs interface through real rclpy in this process: each message published
-and received, each service called and answered, the action goal with feedback and result."""
+"""
+Every swivel_car_msgs interface through real rclpy in this process.
+
+Each message published and received, each service called and answered, the action goal with
+feedback and result.
+"""
 
 from __future__ import annotations
 

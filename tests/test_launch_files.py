@@ -1,6 +1,10 @@
-"""The launch files are for users with a full Jazzy install (launch_ros is not installable
-here), so they cannot run in this suite. Parse each one instead and check that every
-executable and parameter file it names is installed where launch_ros will look."""
+"""
+The launch files, checked without running them.
+
+They are for users with a full Jazzy install (launch_ros is not installable here), so they
+cannot run in this suite. Parse each one instead and check that every executable and
+parameter file it names is installed where launch_ros will look.
+"""
 
 from __future__ import annotations
 
@@ -8,7 +12,7 @@ import ast
 from pathlib import Path
 
 import pytest
-from swivel_car_testing import INSTALL_DIR, REPO_ROOT, executable_path
+from swivel_car_testing import executable_path, INSTALL_DIR, REPO_ROOT
 
 LAUNCH_FILES = sorted(REPO_ROOT.glob('swivel_car_*/launch/*.launch.py'))
 
@@ -55,7 +59,7 @@ def test_launch_file_names_installed_things(launch_file: Path):
 
 
 def _respawned(launch_file: Path) -> dict[str, bool]:
-    """Executable -> whether its Node action has respawn=True."""
+    """Map each executable to whether its Node action has respawn=True."""
     tree = ast.parse(launch_file.read_text(), filename=str(launch_file))
     found = {}
     for call in ast.walk(tree):

@@ -1,6 +1,10 @@
-"""A Jazzy user's tools (issue 16), through the installed executables: a recorded run read back
-by an independent MCAP reader, the robot model on the graph for a late subscriber, the live
-Foxglove view through a WebSocket client, and a bag that survives a full disk."""
+"""
+A Jazzy user's tools (issue 16), through the installed executables.
+
+A recorded run read back by an independent MCAP reader, the robot model on the graph for a
+late subscriber, the live Foxglove view through a WebSocket client, and a bag that survives a
+full disk.
+"""
 
 from __future__ import annotations
 
@@ -16,13 +20,11 @@ import textwrap
 import time
 import xml.etree.ElementTree as ElementTree
 
-import pytest
-import websockets
-import yaml
 from geometry_msgs.msg import TwistStamped
 from mcap.reader import make_reader
 from mcap_ros2._dynamic import generate_dynamic
 from mcap_ros2.decoder import DecoderFactory
+import pytest
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -30,6 +32,8 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from swivel_car_msgs.srv import StepSimulation
 from swivel_car_testing import INSTALL_DIR, NodeProcess, spin_until
+import websockets
+import yaml
 
 PERIODS = 40  # control periods the recorded run steps
 STEPS_PER_PERIOD = 5  # physics steps per control period (sim_node.yaml: 0.01 s / 0.002 s)
@@ -151,7 +155,7 @@ def test_a_recorded_run_reads_back_with_an_independent_reader(ros_domain, tmp_pa
         assert 0 <= log_time - _stamp(state) < 1_000_000_000
     assert max(recorded) == _stamp(stepped[-1])
     clock = [t.clock.sec * 1_000_000_000 + t.clock.nanosec for _, t in messages['/clock']]
-    assert set(_stamp(s) for s in stepped) <= set(clock)
+    assert {_stamp(s) for s in stepped} <= set(clock)
     # The model travels with the data.
     (_, description), = messages['/robot_description']
     assert set(stepped[-1].name) <= set(_urdf_joints(description.data))
@@ -264,7 +268,7 @@ def test_a_bad_output_is_one_fatal_line(ros_domain, tmp_path):
 
 # In a mount namespace of its own, on a 3 MB file system: write 100 kB messages until the
 # writer stops, then read the bag back.
-_FULL_DISK = textwrap.dedent('''
+_FULL_DISK = textwrap.dedent("""
     import json, sys
     from pathlib import Path
     from ament_index_python.packages import get_package_share_directory
@@ -283,7 +287,7 @@ _FULL_DISK = textwrap.dedent('''
     print(json.dumps({'written': written, 'stopped': bag.stopped,
                       'read': summary.statistics.message_count,
                       'metadata': (disk / 'bag' / 'metadata.yaml').is_file()}))
-''')
+""")
 
 
 def test_a_full_disk_stops_the_bag_closed_and_readable(tmp_path):

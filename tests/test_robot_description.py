@@ -1,6 +1,9 @@
-"""Every node runs the one robot description (swivel_car_model.description): with its installed
-configuration each node declares the description's parameters with the description's
-values, and its cores are built from them. A copy that drifts fails here."""
+"""
+Every node runs the one robot description (swivel_car_model.description).
+
+With its installed configuration each node declares the description's parameters with the
+description's values, and its cores are built from them. A copy that drifts fails here.
+"""
 
 from __future__ import annotations
 

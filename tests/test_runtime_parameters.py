@@ -1,7 +1,10 @@
-"""Runtime `ros2 param set` on every node, the ROS 2 way (issue 12: `param set /sim time_step
--1`, `real_time_factor 0.5` or a NaN was "Set parameter successful" and nothing changed): a
-parameter either applies live or is read-only, and a bad value is refused with the reason
-`ros2 param set` prints."""
+"""
+Runtime `ros2 param set` on every node, the ROS 2 way.
+
+A parameter either applies live or is read-only, and a bad value is refused with the reason
+`ros2 param set` prints. Before (issue 12), `param set /sim time_step -1`,
+`real_time_factor 0.5` or a NaN was "Set parameter successful" and nothing changed.
+"""
 
 import math
 

@@ -1,13 +1,16 @@
-"""Ctrl-C (SIGINT) and SIGTERM end every node of a busy stack with exit code 0 and no
-traceback (issue 12: the controller ended with exit 1 and an RCLError traceback, "publisher's
+"""
+Ctrl-C (SIGINT) and SIGTERM end every node of a busy stack with exit code 0 and no traceback.
+
+Before (issue 12), the controller ended with exit 1 and an RCLError traceback, "publisher's
 context is invalid", when the signal landed while it answered a joint_states; the sim with
-"failed to initialize wait set")."""
+"failed to initialize wait set".
+"""
 
 import signal
 import time
 
 import pytest
-from swivel_car_testing import NodeProcess, next_domain_id
+from swivel_car_testing import next_domain_id, NodeProcess
 
 SIM_TIME = {'use_sim_time': True}
 NODES = [('swivel_car_control', 'controller_node', SIM_TIME),

@@ -1,6 +1,9 @@
-"""InProcessStack: fast, deterministic checks of the in-process stack (no ROS, sim time only).
+"""
+InProcessStack: fast, deterministic checks of the in-process stack (no ROS, sim time only).
+
 Its identity with the ROS lockstep run, bit for bit per control period, is checked by
-tests/test_inprocess_identity.py."""
+tests/test_inprocess_identity.py.
+"""
 
 from __future__ import annotations
 
@@ -8,9 +11,8 @@ import math
 
 import numpy as np
 import pytest
-from swivel_car_model.description import CarDescription
-
 from swivel_car_bringup.inprocess import InProcessStack, StackConfig
+from swivel_car_model.description import CarDescription
 from swivel_car_planner.core import ClimbRequest, ErrorCode
 
 

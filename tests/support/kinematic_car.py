@@ -1,4 +1,5 @@
-"""A kinematic stand-in for the robot on flat ground, for tests of the climb logic.
+"""
+A kinematic stand-in for the robot on flat ground, for tests of the climb logic.
 
 The model's planar kinematics (``planar.OffsetTricycleOdometry``) integrate the commanded
 swivel and drive; the swivel follows the rate-limited set point, exactly or ``sag`` short of
@@ -44,7 +45,7 @@ class KinematicCar:
         self.step_pitch = 0.0  # [rad] nose up, the front axle on the step and the rear below
 
     def place_step(self, height: float, distance: float, yaw: float = 0.0) -> None:
-        """A step as a climb request names it from the car's pose now. # [m], [rad]"""
+        """Place a step where a climb request names it from the car's pose now [m], [rad]."""
         pose = Pose2D(self.odometry.x, self.odometry.y, self.odometry.yaw)
         self.step = StepEdge.from_request(pose, self.p.wheelbase, distance, yaw)
         self.step_pitch = math.asin(min(1.0, height / self.p.wheelbase))
@@ -58,7 +59,7 @@ class KinematicCar:
         return -self.step_pitch if front > 0.0 > rear else 0.0
 
     def observe(self) -> Observation:
-        """The car's state; the swivel torque is a stand-in, 10 N m/rad of swivel angle."""
+        """Return the car's state; the swivel torque is a stand-in, 10 N m/rad of swivel angle."""
         return Observation(
             time=self.time, x=self.odometry.x, y=self.odometry.y, yaw=self.odometry.yaw,
             swivel=self.swivel, swivel_rate=self.rate, set_point=self.set_point,
