@@ -27,6 +27,7 @@ setup(
             'robot_description_node = swivel_car_bringup.robot_description_node:main',
             'foxglove_bridge_node = swivel_car_bringup.foxglove_bridge_node:main',
             'campaign = swivel_car_bringup.campaign:main',
+            'design_report = swivel_car_bringup.design_report:main',
         ],
     },
 )

@@ -65,12 +65,12 @@ from swivel_car_bringup.climb_benchmark import climb_trial, RequestRanges, Trial
 from swivel_car_bringup.inprocess import InProcessStack, StackConfig
 
 _SECTIONS = ('design', 'procedure', 'trials')
-_TRIAL_COLUMNS = ('height', 'trial', 'seed', 'distance', 'yaw', 'width', 'offset')
+TRIAL_COLUMNS = ('height', 'trial', 'seed', 'distance', 'yaw', 'width', 'offset')
 # The result columns: climb_benchmark.Trial's fields but the request's (trial columns), some
 # renamed to say what they are in a table of their own.
 _RESULT_COLUMNS = {item.name: {'code': 'error_code', 'front': 'front_on_top',
                                'four': 'four_wheels_on_top'}.get(item.name, item.name)
-                   for item in fields(Trial) if item.name not in _TRIAL_COLUMNS}
+                   for item in fields(Trial) if item.name not in TRIAL_COLUMNS}
 _RUN_COLUMNS = ('wall', 'ray_node', 'git_revision')
 # Ray: the workers' output (pybullet's banner) kept from the driver, failures come back as
 # exceptions; a local instance without a dashboard and with a small object store (a trial's
@@ -111,7 +111,7 @@ class TrialSpec:
 
     def columns(self) -> dict[str, str]:
         """The trial and its full configuration as CSV cells: the key of its row."""
-        cells = {name: getattr(self, name) for name in _TRIAL_COLUMNS}
+        cells = {name: getattr(self, name) for name in TRIAL_COLUMNS}
         cells.update({f'design.{k}': v for k, v in asdict(self.config.robot).items()})
         cells.update({f'procedure.{k}': v for k, v in asdict(self.config.planner).items()})
         return {name: _cell(value) for name, value in cells.items()}
@@ -138,7 +138,7 @@ def _floats(values: dict[str, Any]) -> dict[str, Any]:
 
 def key_columns() -> list[str]:
     """The columns that make two rows the same trial: the trial and its configuration."""
-    return ([*_TRIAL_COLUMNS]
+    return ([*TRIAL_COLUMNS]
             + [f'design.{item.name}' for item in fields(CarDescription)]
             + [f'procedure.{item.name}' for item in fields(PlannerConfig)])
 
