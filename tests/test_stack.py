@@ -15,16 +15,20 @@ from typing import Iterator
 
 import pytest
 import rclpy
+from builtin_interfaces.msg import Time
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
+from rcl_interfaces.srv import SetParameters
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.task import Future
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
-from std_srvs.srv import Empty
+from std_srvs.srv import Empty, SetBool
 from swivel_car_model.params import SwivelCarParams
-from swivel_car_msgs.msg import StepObstacle, SwivelControllerState
+from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
 from sim_session import GroundTruth
 from swivel_car_testing import (
@@ -37,10 +41,19 @@ NODES = {'sim': ('swivel_car_sim', 'sim_node'),
 # A killed controller must not freeze the lockstep sim for long: after this many wall seconds
 # without a command it steps on with its watchdog.
 LOCKSTEP_TIMEOUT = 0.1  # [s]
+# The controller's deadmans (controller_node.yaml), and the most its drive limit
+# (max_linear_acceleration 1 m/s^2) then takes to stop the car from 0.3 m/s.
+DEADMAN = 0.5  # [s]
+BRAKING = 0.3  # [s]
 
 
 def seconds(stamp) -> float:
     return stamp.sec + 1e-9 * stamp.nanosec  # [s]
+
+
+def time_msg(t: float) -> Time:
+    """Return the stamp of time ``t`` [s]."""
+    return Time(sec=int(t), nanosec=int(round((t - int(t)) * 1e9)))
 
 
 class Stack:
@@ -63,6 +76,13 @@ class Stack:
         self.user.create_subscription(SwivelControllerState, 'controller/controller_state',
                                       self.controller_states.append, 100)
         self.cmd_vel = self.user.create_publisher(TwistStamped, 'cmd_vel', 10)
+        # A user's (or a faulty driver's) messages on the sim's and the planner's topics.
+        self.clock = self.user.create_publisher(Clock, '/clock', 10)
+        self.joint_states = self.user.create_publisher(JointState, 'joint_states', 10)
+        self.swivel_command = self.user.create_publisher(SwivelCommand, 'swivel_command', 10)
+        self.set_paused = self.user.create_client(SetBool, 'sim/set_paused')
+        self.set_controller_parameters = self.user.create_client(
+            SetParameters, 'controller/set_parameters')
         self.spawn = self.user.create_client(SpawnObstacle, 'sim/spawn_obstacle')
         self.reset_sim = self.user.create_client(ResetSimulation, 'sim/reset')
         self.reset_odometry = self.user.create_client(Empty, 'odometry/reset')
@@ -134,6 +154,11 @@ class Stack:
     def wait_sim_time(self, duration: float, what: str) -> None:
         end = self.sim_time() + duration
         self.spin_until(lambda: self.sim_time() >= end, 120.0, what)
+
+    def wait_wall(self, duration: float, what: str) -> None:
+        """Spin for ``duration`` wall seconds [s] (the sim may be paused)."""
+        end = time.monotonic() + duration
+        self.spin_until(lambda: time.monotonic() > end, duration + 10.0, what)
 
     def drive(self, speed: float, duration: float, omega: float = 0.0,
               until=lambda: False) -> None:
@@ -398,4 +423,96 @@ def test_killed_odometry_mid_climb_ends_the_climb_and_a_restart_recovers(stack: 
     stack.wait_stopped(1.0, 'the car to stop')
 
     stack.restart('odometry')
+    stack.wait_planner_ready()
+
+
+def test_a_use_sim_time_flip_mid_drive_does_not_stretch_the_cmd_vel_deadman(stack: Stack):
+    """
+    Check the issue 12 fault: `ros2 param set /controller use_sim_time false` mid-drive.
+
+    Then the cmd_vel publisher stopped: the car drove on 1.35 m in 5 s. Here the flip goes
+    through the executable's parameter service, and the car is judged by the ground truth.
+    """
+    def use_sim_time(value: bool) -> None:
+        request = SetParameters.Request(parameters=[
+            Parameter('use_sim_time', Parameter.Type.BOOL, value).to_parameter_msg()])
+        result = stack.call(stack.set_controller_parameters, request, 'set_parameters')
+        assert result.results[0].successful, result.results[0].reason
+
+    stack.drive(0.3, 1.0)
+    try:
+        use_sim_time(False)
+        # The controller now stamps cmd_vel with wall time on receipt: it still obeys it...
+        stack.drive(0.3, 0.5)
+        assert stack.speed() > 0.2, 'the flipped controller no longer obeys cmd_vel'
+        # ...and stops the car within its deadman once it no longer comes.
+        stack.wait_stopped(DEADMAN + BRAKING + 0.1, 'the car to stop after the flip')
+        stack.wait_sim_time(1.0, 'the car to stand')
+        assert stack.speed() < 0.02
+        use_sim_time(True)
+    except BaseException:
+        stack.kill('controller')  # the next test gets a new one, on sim time
+        raise
+
+
+def test_a_clock_far_ahead_stretches_no_deadman_and_every_node_survives_it(stack: Stack):
+    """
+    Check the issue 12 fault: one /clock of 2^31-1 s, then a held swivel_command.
+
+    The car was still moving 5.3 s later (deadman 0.5 s). The sim is paused while the
+    fake moment is the controller's time, so that the command is received in it.
+    """
+    stack.call(stack.set_paused, SetBool.Request(data=True), 'sim/set_paused')
+    stack.clock.publish(Clock(clock=time_msg(2.0**31 - 1)))
+    stack.wait_wall(0.3, 'the nodes to hear the /clock')
+    stack.swivel_command.publish(SwivelCommand(angle=0.0, drive_speed=3.0, hold=True))
+    stack.wait_wall(0.3, 'the controller to hear the swivel_command')
+    stack.call(stack.set_paused, SetBool.Request(data=False), 'sim/set_paused')
+    start = stack.sim_time()
+    stack.spin_until(lambda: stack.speed() > 0.1, 60.0, 'the held command to drive')
+    stack.spin_until(lambda: stack.speed() < 0.02, 60.0, 'the deadman to stop the car')
+    assert stack.sim_time() - start <= DEADMAN + BRAKING + 0.1, stack.sim_time() - start
+
+    # Every node went on (spin_until checks their processes): the odometry follows the
+    # car, the planner takes requests, cmd_vel drives.
+    stack.drive(0.3, 1.0)
+    stack.stop(1.0)
+    assert stack.x() > 0.3
+    stack.wait_sim_time(0.1, 'the odometry of the stop')
+    assert stack.odom[-1].pose.pose.position.x == pytest.approx(stack.x(), rel=0.05)
+    stack.wait_planner_ready()
+
+
+def test_single_untrusted_joint_states_while_driving_move_neither_odom_nor_car(stack: Stack):
+    """
+    Check the issue 12 fault: one impossible joint_states corrupted the odometry for good.
+
+    Wheel rates of 1e300 or -1e12 once moved the odom 0.2-0.7 m; one stamp of 0 s, 1 s or
+    2^31-1 s while driving put it 22 m to 7e5 m off. The controller and the planner hear
+    these messages too.
+    """
+    names = ['swivel_joint', 'rear_left_wheel_joint', 'rear_right_wheel_joint']
+
+    def joint_state(t: float, wheel_rate: float) -> JointState:
+        return JointState(header=Header(stamp=time_msg(t)), name=names,
+                          position=[0.0, 0.0, 0.0], velocity=[0.0, wheel_rate, wheel_rate])
+
+    stack.drive(0.3, 0.5)
+    odom_count = len(stack.odom)
+    for bad in (lambda t: joint_state(t + 0.005, 1e300),
+                lambda t: joint_state(t + 0.005, -1e12),
+                lambda t: joint_state(0.0, 4.0), lambda t: joint_state(1.0, 4.0),
+                lambda t: joint_state(2.0**31 - 1, 4.0)):
+        stack.joint_states.publish(bad(stack.sim_time()))
+        stack.drive(0.3, 0.3)
+    stack.stop(1.0)
+    stack.wait_sim_time(0.1, 'the odometry of the stop')
+
+    odom = stack.odom[odom_count:]
+    steps = [math.hypot(b.pose.pose.position.x - a.pose.pose.position.x,
+                        b.pose.pose.position.y - a.pose.pose.position.y)
+             for a, b in zip(odom, odom[1:])]
+    assert max(steps) < 0.02, f'the odom jumped {max(steps):.3g} m'
+    assert stack.x() > 0.45, 'the car did not go on obeying cmd_vel'  # 0.55 m undisturbed
+    assert odom[-1].pose.pose.position.x == pytest.approx(stack.x(), rel=0.05)
     stack.wait_planner_ready()
