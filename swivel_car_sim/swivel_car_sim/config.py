@@ -8,6 +8,7 @@ it. ROS-free.
 from __future__ import annotations
 
 from dataclasses import dataclass
+import math
 
 from swivel_car_model import description
 from swivel_car_model.checks import check_finite_number
@@ -121,7 +122,7 @@ class SimNodeConfig:
 
 def _whole_ratio(numerator: float, denominator: float, name: str, of: str) -> int:
     ratio = numerator / denominator
-    whole = round(ratio)
+    whole = round(ratio) if math.isfinite(ratio) else 0
     if whole < 1 or abs(ratio - whole) > 1e-6 * max(1.0, ratio):
         raise ValueError(f'{name} ({numerator!r}) must be a whole multiple (>= 1) of {of} '
                          f'({denominator!r})')

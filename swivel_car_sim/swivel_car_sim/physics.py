@@ -42,6 +42,9 @@ from swivel_car_sim.urdf import build_robot, RobotModel
 
 GRAVITY = 9.81  # [m/s^2]
 MAX_STEPS_PER_CALL = 100_000
+# Bullet computes in single precision here: 1 km from the origin a float32 resolves 0.06 mm,
+# still far below a wheel's contact; further out the physics degrades without a warning.
+WORLD_HALF_EXTENT = 1000.0  # [m]
 # Without URDF_USE_IMPLICIT_CYLINDER pybullet turns URDF cylinders into polygonal hulls and the
 # wheels bump over their facets (the body hopped 0.4 mm every facet, the IMU's vertical
 # specific force had a 3.4 m/s^2 standard deviation at 0.37 m/s).
@@ -391,12 +394,17 @@ class SwivelCarSim:
         Raises
         ------
         ValueError
-            Non-finite pose, or the robot would overlap an obstacle; nothing changes.
+            Non-finite pose, a position beyond WORLD_HALF_EXTENT, or the robot would
+            overlap an obstacle; nothing changes.
 
         """
         for name, value in (('x', x), ('y', y), ('yaw', yaw)):
             if not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise ValueError(f'{name} must be finite, got {value!r}')
+        for name, value in (('x', x), ('y', y)):
+            if abs(value) > WORLD_HALF_EXTENT:
+                raise ValueError(f'{name} must be within +-{WORLD_HALF_EXTENT} m of the '
+                                 f'origin, got {value!r}')
         if not remove_obstacles:
             blocking = self._obstacles_overlapping_robot_at(x, y, yaw)
             if blocking:

@@ -38,6 +38,7 @@ def test_rates_and_geometry_overrides():
 @pytest.mark.parametrize('values, message', [
     ({'control_period': 0.005 + 0.001}, 'control_period'),
     ({'control_period': 0.001}, 'control_period'),
+    ({'control_period': 1e306}, 'control_period'),
     ({'imu_rate': 0.0}, 'imu_rate'),
     ({'ground_truth_rate': 70.0}, 'ground_truth_rate'),
     ({'lockstep_timeout': -1.0}, 'lockstep_timeout'),
