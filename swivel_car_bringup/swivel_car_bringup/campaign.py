@@ -1,4 +1,5 @@
-"""Design campaigns: climbs of a grid of robot designs and procedures, in parallel on Ray.
+"""
+Design campaigns: climbs of a grid of robot designs and procedures, in parallel on Ray.
 
     python -m swivel_car_bringup.campaign SWEEP.yaml --out results.csv [--workers N]
         [--address ADDR]
@@ -56,13 +57,11 @@ import sys
 import time
 from typing import Any, TextIO
 
-import yaml
-
-from swivel_car_model.description import CarDescription
-from swivel_car_planner.core import ClimbRequest, ErrorCode, PlannerConfig, validate_request
-
 from swivel_car_bringup.climb_benchmark import climb_trial, RequestRanges, Trial
 from swivel_car_bringup.inprocess import InProcessStack, StackConfig
+from swivel_car_model.description import CarDescription
+from swivel_car_planner.core import ClimbRequest, ErrorCode, PlannerConfig, validate_request
+import yaml
 
 _SECTIONS = ('design', 'procedure', 'trials')
 TRIAL_COLUMNS = ('height', 'trial', 'seed', 'distance', 'yaw', 'width', 'offset')
@@ -110,14 +109,14 @@ class TrialSpec:
     offset: float  # [m]
 
     def columns(self) -> dict[str, str]:
-        """The trial and its full configuration as CSV cells: the key of its row."""
+        """Return the trial and its full configuration as CSV cells: the key of its row."""
         cells = {name: getattr(self, name) for name in TRIAL_COLUMNS}
         cells.update({f'design.{k}': v for k, v in asdict(self.config.robot).items()})
         cells.update({f'procedure.{k}': v for k, v in asdict(self.config.planner).items()})
         return {name: _cell(value) for name, value in cells.items()}
 
     def key(self) -> tuple[str, ...]:
-        """What makes two rows the same trial: the cells of ``columns``."""
+        """Return what makes two rows the same trial: the cells of ``columns``."""
         return tuple(self.columns().values())
 
     def label(self) -> str:
@@ -126,25 +125,25 @@ class TrialSpec:
 
 
 def _cell(value: Any) -> str:
-    """A CSV cell; a float reads back as the same float, an enum member is its name."""
+    """Format a CSV cell: a float reads back as the same float, an enum member is its name."""
     return value.name if isinstance(value, ErrorCode) else str(value)
 
 
 def _floats(values: dict[str, Any]) -> dict[str, Any]:
-    """An integer where a number is due counts as that float (as the nodes take it)."""
+    """Turn an integer where a number is due into that float (as the nodes take it)."""
     return {name: float(value) if isinstance(value, int) and not isinstance(value, bool)
             else value for name, value in values.items()}
 
 
 def key_columns() -> list[str]:
-    """The columns that make two rows the same trial: the trial and its configuration."""
+    """Return the columns that make two rows the same trial: the trial and its configuration."""
     return ([*TRIAL_COLUMNS]
             + [f'design.{item.name}' for item in fields(CarDescription)]
             + [f'procedure.{item.name}' for item in fields(PlannerConfig)])
 
 
 def columns() -> list[str]:
-    """The CSV header."""
+    """Return the CSV header."""
     return key_columns() + list(_RESULT_COLUMNS.values()) + list(_RUN_COLUMNS)
 
 
@@ -178,12 +177,14 @@ def _integer(trials: dict, name: str, default: int, minimum: int | None = None) 
 
 
 def parse_sweep(data: Any) -> Sweep:
-    """A sweep from a sweep file's YAML data (module docstring).
+    """
+    Parse a sweep from a sweep file's YAML data (module docstring).
 
     Raises
     ------
     SweepError
         An unknown section or field, a value of the wrong kind, an empty sweep.
+
     """
     data = _mapping(data, 'the sweep file')
     unknown = sorted(set(data) - set(_SECTIONS))
@@ -217,12 +218,14 @@ def parse_sweep(data: Any) -> Sweep:
 
 
 def load_sweep(path: str | Path) -> Sweep:
-    """``parse_sweep`` of a file.
+    """
+    ``parse_sweep`` of a file.
 
     Raises
     ------
     SweepError
         Also for a file that cannot be read or is not YAML.
+
     """
     try:
         data = yaml.safe_load(Path(path).read_text())
@@ -241,14 +244,18 @@ def _text(point: dict[str, Any]) -> str:
 
 
 def plan_trials(sweep: Sweep) -> list[TrialSpec]:
-    """Every trial of the sweep, design point by design point, each configuration and
-    request validated by the description, the planner's configuration and its request check.
+    """
+    Plan every trial of the sweep, design point by design point.
+
+    Each configuration and request is validated by the description, the planner's
+    configuration and its request check.
 
     Raises
     ------
     SweepError
         A design or procedure point, or a drawn request, those refuse; the message names the
         field. Or the grid repeats a trial (a value listed twice).
+
     """
     draws = {(height, index): sweep.ranges.draw(
         random.Random(f'{sweep.seed}:{height!r}:{index}'))
@@ -273,7 +280,7 @@ def plan_trials(sweep: Sweep) -> list[TrialSpec]:
                         step_height=height, step_distance=distance, step_yaw=yaw,
                         step_width=width, step_offset=offset), config.planner)
                     if code != ErrorCode.NONE:
-                        raise SweepError(f'trials (height {height!r} m, the ranges\' '
+                        raise SweepError(f"trials (height {height!r} m, the ranges' "
                                          f'bounds): {message}')
             point = tuple((name, {**design, **procedure}[name]) for name in swept_names)
             for (height, index), (distance, yaw, width, offset) in draws.items():
@@ -291,7 +298,7 @@ def plan_trials(sweep: Sweep) -> list[TrialSpec]:
 # --- one trial (on a Ray worker) ------------------------------------------------------------
 
 def result_cells(trial: Trial, wall: float) -> dict[str, str]:
-    """The result columns of a climbed trial that took ``wall`` [s]."""
+    """Return the result columns of a climbed trial that took ``wall`` [s]."""
     cells = {column: _cell(getattr(trial, name)) for name, column in _RESULT_COLUMNS.items()}
     cells['message'] = ' '.join(trial.message.split())  # one row, one line
     cells['wall'] = _cell(wall)
@@ -314,8 +321,11 @@ def _run_on_worker(spec: TrialSpec) -> dict[str, str]:
 
 @contextlib.contextmanager
 def ray_session(workers: int | None, address: str | None) -> Iterator[int]:
-    """Ray, local (``workers`` CPUs, default all) or joined at ``address``; yields how many
-    trials run at once."""
+    """
+    Start Ray, local (``workers`` CPUs, default all), or join it at ``address``.
+
+    Yields how many trials run at once.
+    """
     import ray
     if address:
         ray.init(address=address, **_RAY_OPTIONS)
@@ -331,9 +341,12 @@ def ray_session(workers: int | None, address: str | None) -> Iterator[int]:
 
 def ray_results(trials: list[TrialSpec], at_once: int
                 ) -> Iterator[tuple[TrialSpec, dict[str, str] | Exception]]:
-    """Run ``trials`` on the connected Ray, at most ``at_once`` at a time (two queued per
-    CPU, so none idles between trials); yield each with its result columns, or the exception
-    it raised, as it finishes."""
+    """
+    Run ``trials`` on the connected Ray, at most ``at_once`` at a time.
+
+    Two are queued per CPU, so none idles between trials. Yields each with its result
+    columns, or the exception it raised, as it finishes.
+    """
     import ray
     remote = ray.remote(num_cpus=1)(_run_on_worker)
     queue, running = list(reversed(trials)), {}
@@ -353,13 +366,16 @@ def ray_results(trials: list[TrialSpec], at_once: int
 # --- the results file -----------------------------------------------------------------------
 
 def finished_keys(out: Path) -> set[tuple[str, ...]]:
-    """The keys of the trials in ``out`` (none if it does not exist). A last row cut short
-    (the campaign killed while writing it) is removed from the file.
+    """
+    Return the keys of the trials in ``out`` (none if it does not exist).
+
+    A last row cut short (the campaign killed while writing it) is removed from the file.
 
     Raises
     ------
     SweepError
         ``out`` has other columns than this campaign writes.
+
     """
     if not out.exists():
         return set()
@@ -380,7 +396,7 @@ def finished_keys(out: Path) -> set[tuple[str, ...]]:
 
 
 def git_revision() -> str:
-    """This checkout's commit, '+dirty' with uncommitted changes; 'unknown' outside git."""
+    """Return this checkout's commit, '+dirty' with uncommitted changes; 'unknown' outside git."""
     here = Path(__file__).resolve().parent
     try:
         head = subprocess.run(['git', 'rev-parse', 'HEAD'], cwd=here, capture_output=True,
@@ -394,9 +410,12 @@ def git_revision() -> str:
 
 def record(results: Iterable[tuple[TrialSpec, dict[str, str] | Exception]], out: Path,
            total: int, progress: TextIO | None = None) -> int:
-    """Append a row to ``out`` for each finished trial (the header first into a new file),
-    flushed at once; a progress line for each on ``progress`` (default stderr). Returns how
-    many raised."""
+    """
+    Append a row to ``out`` for each finished trial, flushed at once.
+
+    The header goes first into a new file; a progress line for each trial goes to
+    ``progress`` (default stderr). Returns how many raised.
+    """
     progress = progress or sys.stderr
     header, revision = columns(), git_revision()
     new = not out.exists() or out.stat().st_size == 0

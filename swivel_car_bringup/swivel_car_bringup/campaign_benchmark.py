@@ -1,4 +1,5 @@
-"""Campaign benchmark: throughput on 1 and 2 Ray workers, and a campaign killed and resumed.
+"""
+Campaign benchmark: throughput on 1 and 2 Ray workers, and a campaign killed and resumed.
 
     python -m swivel_car_bringup.campaign_benchmark [--trials 24] [--kill-resume [SWEEP]]
 
@@ -65,8 +66,11 @@ def _rows(path: Path) -> list[list[str]]:
 
 
 def kill_and_resume(sweep: Path, out: Path) -> bool:
-    """Run the campaign, SIGKILL it halfway, resume it; True if no trial was redone or
-    lost."""
+    """
+    Run the campaign, SIGKILL it halfway, resume it.
+
+    Returns True if no trial was redone or lost.
+    """
     total = len(plan_trials(load_sweep(sweep)))
     command = [sys.executable, '-m', 'swivel_car_bringup.campaign', str(sweep),
                '--out', str(out)]

@@ -1,4 +1,5 @@
-"""The model's kinematic and torque claims measured in physics, through the in-process stack.
+"""
+The model's kinematic and torque claims measured in physics, through the in-process stack.
 
 Every measurement drives the car as the planner does: a ``swivel_command`` to the controller
 (renewed every control period, the set point ramped at the command's rate), the sim's ground
@@ -15,9 +16,8 @@ import math
 
 import numpy as np
 
-from swivel_car_model import dynamics, kinematics, planar
-
 from swivel_car_bringup.inprocess import InProcessStack, StackConfig
+from swivel_car_model import dynamics, kinematics, planar
 
 SWIVEL_SAMPLES = (0.3, 0.6, 0.9, 1.2)  # [rad] where the standstill sweep is read
 SWEEP_RATE = 0.1  # [rad/s] quasi-static, as the sim's model tests sweep
@@ -38,15 +38,18 @@ class Row:
 
 def _command(stack: InProcessStack, angle: float, rate: float, drive: float,
              duration: float) -> None:
-    """Hold ``angle`` [rad] (reached at ``rate`` [rad/s]) and drive at ``drive`` [rad/s] for
-    ``duration`` [s] of sim time, the command renewed every period as the planner's is."""
+    """
+    Hold ``angle`` [rad] (reached at ``rate`` [rad/s]) and drive at ``drive`` [rad/s].
+
+    For ``duration`` [s] of sim time, the command renewed every period as the planner's is.
+    """
     for _ in range(round(duration / stack.control_period)):
         stack.controller.core.set_swivel_command(angle, rate, drive, True, stack.time)
         stack.settle(stack.control_period)
 
 
 def _in_frame(start, end) -> tuple[float, float, float]:
-    """``end``'s pose in ``start``'s base_link frame: (dx [m], dy [m], dyaw [rad])."""
+    """Return ``end``'s pose in ``start``'s base_link frame: (dx [m], dy [m], dyaw [rad])."""
     dx, dy = (end.position - start.position)[:2]
     c, s = math.cos(start.yaw), math.sin(start.yaw)
     dyaw = math.remainder(end.yaw - start.yaw, math.tau)
@@ -54,9 +57,12 @@ def _in_frame(start, end) -> tuple[float, float, float]:
 
 
 def standstill_sweep(stack: InProcessStack) -> list[Row]:
-    """Swivel 0 -> the tip-safe limit at standstill (drive held at 0): lift angle and the
-    lifted wheel's lowest point at ``SWIVEL_SAMPLES``, and the pose drift of the whole
-    sweep."""
+    """
+    Measure a swivel from 0 to the tip-safe limit at standstill (drive held at 0).
+
+    The rows: lift angle and the lifted wheel's lowest point at ``SWIVEL_SAMPLES``, and the
+    pose drift of the whole sweep.
+    """
     p = stack.car
     limit = stack.controller.core.swivel_limit
     stack.reset()
@@ -74,7 +80,7 @@ def standstill_sweep(stack: InProcessStack) -> list[Row]:
                             f'{-state.pitch:.4f} rad',
                             f'{float(kinematics.lift_angle(p, theta2)):.4f} rad',
                             'eq. 7 (corrected: the model)'))
-            rows.append(Row(f'lifted wheel\'s lowest point at theta2 = {theta2:.3f} rad',
+            rows.append(Row(f"lifted wheel's lowest point at theta2 = {theta2:.3f} rad",
                             f'{lifted * 1000:.1f} mm',
                             f'{float(kinematics.lifted_wheel_lowest_height(p, theta2)) * 1000:.1f}'
                             ' mm', 'eqs. 14-16: not the lowest point (correction 7)'))
@@ -92,9 +98,12 @@ def standstill_sweep(stack: InProcessStack) -> list[Row]:
 
 
 def turning(stack: InProcessStack) -> list[Row]:
-    """Turning radius with the swivel held at each of ``STEER_SAMPLES``, driving: measured
-    as path length over heading change of the ground truth, against the offset tricycle and
-    the thesis' plain tricycle (eq. 76 with the wheelbase corrected, item 21)."""
+    """
+    Measure the turning radius with the swivel held at each of ``STEER_SAMPLES``, driving.
+
+    Path length over heading change of the ground truth, against the offset tricycle and the
+    thesis' plain tricycle (eq. 76 with the wheelbase corrected, item 21).
+    """
     p, rows = stack.car, []
     for target in STEER_SAMPLES:
         stack.reset()
@@ -118,8 +127,11 @@ def turning(stack: InProcessStack) -> list[Row]:
 
 
 def step_torque(stack: InProcessStack, planner_rate: float) -> list[Row]:
-    """Peak swivel torque of lifting the front wheel over the thesis' 12 mm step at
-    standstill, the set point ramped at the planner's ``swivel_rate`` [rad/s]."""
+    """
+    Measure the peak swivel torque of lifting the front wheel over the thesis' 12 mm step.
+
+    At standstill, the set point ramped at the planner's ``swivel_rate`` [rad/s].
+    """
     p = stack.car
     theta2 = float(kinematics.swivel_for_step(p, THESIS_STEP))
     stack.reset()

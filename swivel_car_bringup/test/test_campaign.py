@@ -1,7 +1,10 @@
-"""The campaign command: the sweep file's validation, the grid and its requests, resuming from
-the results file (no Ray), the installed command, and real trials on a two-node Ray cluster
-through --address. Its throughput and a kill-and-resume of a whole campaign are
-``python -m swivel_car_bringup.campaign_benchmark``."""
+"""
+The campaign command, from its sweep file to real trials on a two-node Ray cluster.
+
+The sweep file's validation, the grid and its requests, resuming from the results file (no
+Ray), the installed command, and real trials through --address. Its throughput and a
+kill-and-resume of a whole campaign are ``python -m swivel_car_bringup.campaign_benchmark``.
+"""
 
 from __future__ import annotations
 
@@ -12,13 +15,12 @@ import subprocess
 import sys
 
 import pytest
-import yaml
-from swivel_car_testing import executable_path
-
 from swivel_car_bringup.campaign import (
     finished_keys, main, parse_sweep, plan_trials, record, result_cells, SweepError)
 from swivel_car_bringup.climb_benchmark import Trial
 from swivel_car_planner.core import ErrorCode
+from swivel_car_testing import executable_path
+import yaml
 
 HEIGHTS = {'heights': [0.02]}
 
@@ -91,8 +93,11 @@ def test_the_grid_is_every_combination_and_each_point_meets_the_same_requests():
 
 
 def _climbed(spec, code=ErrorCode.NONE):
-    """The result columns of a trial as a climb would give them, without the physics: the
-    bookkeeping is under test here."""
+    """
+    Return the result columns of a trial as a climb would give them, without the physics.
+
+    The bookkeeping is under test here.
+    """
     trial = Trial(spec.height, spec.distance, spec.yaw, spec.width, spec.offset, code,
                   'done', True, True, 12.0, 30.0, 11.0, 29.0, 0, 4.0, 0.0, True, 9.5)
     return result_cells(trial, 2.5)
