@@ -503,7 +503,7 @@ def write_table(path: Path, claims: list[Claim], figures: list[str]) -> None:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--out', type=Path, default=Path('docs/figures'))
     parser.add_argument('--doc', type=Path, default=None,
                         help='markdown table to write (default: <out>/../thesis_reproduction.md)')

@@ -183,7 +183,7 @@ def process_rtf(seconds: float) -> float | None:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--seconds', type=float, default=5.0, help='wall time per figure')
     parser.add_argument('--listen', type=int, metavar='DOMAIN', help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
