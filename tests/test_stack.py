@@ -1,10 +1,13 @@
-"""The whole stack as a user runs it: the four installed node executables, each in its own
-process, on sim time in lockstep. Driven through cmd_vel and climb_step; judged by the sim's
-ground truth.
+"""
+The whole stack as a user runs it, judged by the sim's ground truth.
+
+The four installed node executables, each in its own process, on sim time in lockstep, driven
+through cmd_vel and climb_step.
 
 One stack serves the module (starting four processes costs seconds): each test begins by
 restarting whatever node is not running and resetting the sim and the odometry, so it does
-not depend on how the one before it ended."""
+not depend on how the one before it ended.
+"""
 
 from __future__ import annotations
 
@@ -13,26 +16,26 @@ import os
 import time
 from typing import Iterator
 
-import pytest
-import rclpy
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
+import pytest
 from rcl_interfaces.srv import SetParameters
+import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.task import Future
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
+from sim_session import GroundTruth
 from std_msgs.msg import Header
 from std_srvs.srv import Empty, SetBool
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
-from sim_session import GroundTruth
 from swivel_car_testing import (
-    NodeProcess, lockstep_parameters, next_domain_id, spin_until, start_node)
+    lockstep_parameters, next_domain_id, NodeProcess, spin_until, start_node)
 
 NODES = {'sim': ('swivel_car_sim', 'sim_node'),
          'controller': ('swivel_car_control', 'controller_node'),
@@ -98,7 +101,7 @@ class Stack:
             'use_sim_time': True, **lockstep_parameters(executable, LOCKSTEP_TIMEOUT)})
 
     def kill(self, name: str) -> None:
-        """kill -9 of node ``name``, as a crash would end it."""
+        """Kill node ``name`` with kill -9, as a crash would end it."""
         self.processes.pop(name).kill()
 
     def restart(self, name: str) -> None:
@@ -119,8 +122,11 @@ class Stack:
         return future.result()
 
     def heal(self) -> None:
-        """Every node running, the car at rest at the origin, no obstacles, odometry zeroed:
-        the start of every test, whatever the test before it left."""
+        """
+        Bring the stack to the start of every test, whatever the test before it left.
+
+        Every node running, the car at rest at the origin, no obstacles, odometry zeroed.
+        """
         if any(not climb.done() for climb in self.climbs):
             self.kill('planner')  # a climb left running would go on in the reset world
         self.climbs.clear()
@@ -137,8 +143,11 @@ class Stack:
         self.wait_sim_time(0.2, 'the odometry reset')
 
     def reset(self) -> float:
-        """sim/reset to the origin, obstacles removed; returns the time of the first state
-        after it. # [s]"""
+        """
+        Reset the sim to the origin through sim/reset, obstacles removed.
+
+        Returns the time of the first state after it [s].
+        """
         count = len(self.resets)
         response = self.call(self.reset_sim, ResetSimulation.Request(remove_obstacles=True),
                              'sim/reset')
@@ -162,8 +171,7 @@ class Stack:
 
     def drive(self, speed: float, duration: float, omega: float = 0.0,
               until=lambda: False) -> None:
-        """Publish cmd_vel at 20 Hz of sim time for ``duration`` sim seconds or until
-        ``until()``."""
+        """Publish cmd_vel at 20 Hz until ``until()``, for at most ``duration`` of sim time [s]."""
         end = self.sim_time() + duration
         while self.sim_time() < end and not until():
             # A zero stamp: the controller stamps it on receipt, so a moment's lag of this
@@ -175,21 +183,23 @@ class Stack:
             self.wait_sim_time(0.05, 'sim time while driving')
 
     def stop(self, within: float) -> None:
-        """A zero cmd_vel stops the car within ``within`` seconds of sim time."""
+        """Stop the car with a zero cmd_vel within ``within`` seconds of sim time."""
         self.drive(0.0, within, until=lambda: self.speed() < 0.01)
         assert self.speed() < 0.01, 'a zero cmd_vel did not stop the car'
 
     def wait_stopped(self, within: float, what: str) -> None:
-        """Until the car stands (ground truth); it must within ``within`` seconds of sim
-        time."""
+        """Wait until the car stands (ground truth), within ``within`` seconds of sim time."""
         start = self.sim_time()
         self.spin_until(lambda: self.speed() < 0.02, 120.0, what)
         assert self.sim_time() - start <= within, f'{what}: {self.sim_time() - start:.2f} s'
 
     def wait_planner_ready(self) -> None:
-        """Until the planner hears the whole stack: a climb out of reach is refused as
-        unreachable (without motion), not as NOT_READY. (A plan-only request is answered
-        before the planner hears anything.)"""
+        """
+        Wait until the planner hears the whole stack.
+
+        That is, until a climb out of reach is refused as unreachable (without motion), not as
+        NOT_READY. (A plan-only request is answered before the planner hears anything.)
+        """
         self.spin_until(self.climb.service_is_ready, 60.0, 'the climb_step service')
         deadline = time.monotonic() + 60.0
         while True:
@@ -215,8 +225,11 @@ class Stack:
         return self.climbs[-1]
 
     def kill_mid_climb(self, name: str) -> Future:
-        """Ask for a 4 cm climb, kill -9 node ``name`` once the car drives; returns the
-        climb's future."""
+        """
+        Ask for a 4 cm climb and kill -9 node ``name`` once the car drives.
+
+        Returns the climb's future.
+        """
         self.wait_planner_ready()
         climb = self.start_climb(ClimbStep.Request(
             step_height=0.04, step_distance=1.0, step_yaw=0.0, plan_only=False))
@@ -290,8 +303,12 @@ def test_drive_then_climb_a_step(stack: Stack):
 
 
 def test_a_sim_reset_leaves_the_car_at_rest_until_a_new_command(stack: Stack):
-    """Found by the soak: after sim/reset the controller steered the swivel back to the
-    angle it held before, and went on with the cmd_vel given before."""
+    """
+    Check a sim reset leaves the car at rest until a new command.
+
+    Found by the soak: after sim/reset the controller steered the swivel back to the angle it
+    held before, and went on with the cmd_vel given before.
+    """
     stack.drive(0.2, 1.5, omega=0.6)
     assert abs(stack.controller_states[-1].measured) > 0.3, 'the swivel did not turn'
     reset_time = stack.reset()
@@ -321,7 +338,7 @@ def test_killed_controller_stops_the_car_and_a_restart_recovers(stack: Stack):
     x_before = stack.x()
     stack.drive(0.3, 2.0)
     assert stack.x() > x_before + 0.4, (
-        f"the restarted controller did not drive the car:\n"
+        f'the restarted controller did not drive the car:\n'
         f"{stack.processes['controller'].output()[-3000:]}")
     stack.stop(1.0)
 
@@ -356,10 +373,13 @@ def test_killed_sim_mid_drive_and_a_new_sim_moves_only_on_a_new_cmd_vel(stack: S
 
 
 def test_killed_odometry_and_planner_mid_drive_leave_cmd_vel_in_control(stack: Stack):
-    """Neither is in the cmd_vel loop (docs/architecture.md): the car goes on obeying
-    cmd_vel without them. A restarted odometry starts again at the origin of a new odom
-    frame, as a restarted diff_drive_controller or robot_localization does (odometry/
-    set_pose re-aligns it)."""
+    """
+    Check the car goes on obeying cmd_vel with the odometry and the planner killed.
+
+    Neither is in the cmd_vel loop (docs/architecture.md). A restarted odometry starts again at
+    the origin of a new odom frame, as a restarted diff_drive_controller or robot_localization
+    does (odometry/set_pose re-aligns it).
+    """
     stack.drive(0.3, 0.5)
     stack.kill('odometry')
     stack.kill('planner')

@@ -1,6 +1,9 @@
-"""The controller core and the odometry against the real pybullet sim physics, in lockstep in
-one process (deterministic: sim time only). The same behaviour through the ROS executables is
-in test_system.py."""
+"""
+The controller core and the odometry against the real pybullet sim physics, in lockstep.
+
+All in one process (deterministic: sim time only). The same behaviour through the ROS
+executables is in test_system.py.
+"""
 
 import math
 
@@ -14,7 +17,7 @@ from swivel_car_control.core.controller import ControllerConfig
 @pytest.fixture
 def loop():
     closed_loop = ClosedLoop(config=ControllerConfig(cmd_vel_timeout=0.5,
-                                                      swivel_command_timeout=0.0))
+                                                     swivel_command_timeout=0.0))
     yield closed_loop
     closed_loop.close()
 
@@ -104,10 +107,14 @@ def test_swivel_step_response(loop, start, target):
 
 @pytest.mark.parametrize('name', ['straight_5m', 'turn_on_the_spot'])
 def test_odometry_on_standard_routes(name):
-    """End-pose error as a share of the distance: the offset model within 1.5 % (the sim's
-    wheel slip in tight turns costs it up to ~1 %), with the rear-axle yaw rate too (the rear
-    wheels carry 53 % of the weight and slip in a turn on the spot: 1.1 %), and the offset
-    model's heading far better than the plain tricycle's where the swivel is large."""
+    """
+    Check the odometry's end-pose error on a standard route, as a share of the distance.
+
+    The offset model within 1.5 % (the sim's wheel slip in tight turns costs it up to ~1 %),
+    with the rear-axle yaw rate too (the rear wheels carry 53 % of the weight and slip in a
+    turn on the spot: 1.1 %), and the offset model's heading far better than the plain
+    tricycle's where the swivel is large.
+    """
     loop = ClosedLoop()
     try:
         result = loop.drive(name, routes(loop.p)[name])

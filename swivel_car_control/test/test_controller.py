@@ -3,11 +3,11 @@
 import dataclasses
 import math
 
-import pytest
 from hypothesis import given, settings, strategies as st
+import pytest
 
 from swivel_car_control.core.controller import (
-    SOURCE_CMD_VEL, SOURCE_HOLD, SOURCE_SWIVEL_COMMAND, ControllerConfig, SwivelController)
+    ControllerConfig, SOURCE_CMD_VEL, SOURCE_HOLD, SOURCE_SWIVEL_COMMAND, SwivelController)
 from swivel_car_model.params import SwivelCarParams
 
 P = SwivelCarParams()
@@ -19,8 +19,11 @@ def make(p=P, **overrides):
 
 
 def run(controller, t0, seconds, measured=None):
-    """Step for ``seconds``; the swivel sits at ``measured`` or, if None, follows the set
-    point perfectly."""
+    """
+    Step ``controller`` for ``seconds`` from ``t0`` and return its last output.
+
+    The swivel sits at ``measured`` or, if None, follows the set point perfectly.
+    """
     out = None
     for k in range(int(round(seconds / DT))):
         angle = measured if measured is not None else (out.set_point if out else 0.0)
@@ -140,8 +143,12 @@ def test_free_swivel_command_gives_no_torque_and_holds_at_the_tip_safe_limit():
 
 
 def test_stale_swivel_command_is_released_holding_the_swivel():
-    """The planner died: its last command (driving, swivel at 0.6) expires, the drive stops,
-    the swivel holds where the command left it, and cmd_vel steers again."""
+    """
+    Check a stale swivel command is released and the swivel held where it left it.
+
+    The planner died: its last command (driving, swivel at 0.6) expires, the drive stops, the
+    swivel holds where the command left it, and cmd_vel steers again.
+    """
     controller = make(cmd_vel_timeout=0.0, swivel_command_timeout=0.5)
     controller.set_swivel_command(0.6, 0.0, 2.0, True, 0.0)
     out = run(controller, 0.0, 0.5)
@@ -187,8 +194,12 @@ def test_time_going_back_restarts():
 
 
 def test_a_world_reset_drops_the_commands_and_holds_the_swivel_measured_after_it():
-    """The sim's ~/reset put the car back at rest with the swivel at 0 while the controller
-    held 0.6 rad: it re-steered to 0.6 (found by the soak)."""
+    """
+    Check a world reset drops the commands and holds the swivel measured after it.
+
+    The sim's ~/reset put the car back at rest with the swivel at 0 while the controller held
+    0.6 rad: it re-steered to 0.6 (found by the soak).
+    """
     controller = make(cmd_vel_timeout=0.0, swivel_command_timeout=0.0)
     controller.set_cmd_vel(0.2, 0.4, 0.0)
     run(controller, 0.0, 1.0)

@@ -1,15 +1,18 @@
-"""The controller core's deadmans count in the time of its steps, whatever clock stamped a
-command (issue 12: after a runtime use_sim_time flip, a /clock of 2^31-1 s or a restarted
-sim, the car went on driving with no one commanding it)."""
+"""
+The controller core's deadmans count in the time of its steps, whatever clock stamped a command.
+
+Before (issue 12), after a runtime use_sim_time flip, a /clock of 2^31-1 s or a restarted sim,
+the car went on driving with no one commanding it.
+"""
 
 import math
 
-import pytest
 from hypothesis import given, settings, strategies as st
-from swivel_car_model.description import CarDescription
+import pytest
 
 from swivel_car_control.core.controller import (
-    SOURCE_HOLD, SOURCE_SWIVEL_COMMAND, ControllerConfig, SwivelController)
+    ControllerConfig, SOURCE_HOLD, SOURCE_SWIVEL_COMMAND, SwivelController)
+from swivel_car_model.description import CarDescription
 
 P = CarDescription().model_params()
 DT = 0.01  # [s]

@@ -1,22 +1,24 @@
-"""The controller node's deadmans hold whatever its clock does (issue 12): a runtime
-`ros2 param set /controller use_sim_time false` mid-drive, then the cmd_vel publisher
-stopped, left the car driving (1.35 m in 5 s); one /clock of 2^31-1 s, then a held
-swivel_command, left it moving 5.3 s later (deadman 0.5 s)."""
+"""
+The controller node's deadmans hold whatever its clock does (issue 12).
+
+Before, a runtime `ros2 param set /controller use_sim_time false` mid-drive, then the cmd_vel
+publisher stopped, left the car driving (1.35 m in 5 s); one /clock of 2^31-1 s, then a held
+swivel_command, left it moving 5.3 s later (deadman 0.5 s).
+"""
 
 import os
 
-import pytest
-import rclpy
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import TwistStamped
+import pytest
+import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
+from swivel_car_control.controller_node import ControllerNode
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand
 from swivel_car_testing import next_domain_id, spin_until
-
-from swivel_car_control.controller_node import ControllerNode
 
 TIMEOUT = 0.5  # [s] both deadmans
 PERIOD = 0.01  # [s]

@@ -2,8 +2,8 @@
 
 import math
 
-import pytest
 from hypothesis import given, settings, strategies as st
+import pytest
 
 from swivel_car_control.core.limits import SlewLimiter, steering_speed_scale
 

@@ -1,24 +1,26 @@
-"""In-process node tests: real rclpy, the nodes' topics and services, driven by hand-made
-joint_states (no sim), each test on a fresh ROS domain."""
+"""
+In-process node tests: real rclpy, the nodes' topics and services.
+
+Driven by hand-made joint_states (no sim), each test on a fresh ROS domain.
+"""
 
 import math
 import os
 
-import pytest
-import rclpy
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
+import pytest
+import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
 from std_srvs.srv import Empty
+from swivel_car_control.controller_node import ControllerNode
+from swivel_car_control.odometry_node import OdometryNode
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import SetPose2D
 from swivel_car_testing import next_domain_id, spin_until
-
-from swivel_car_control.controller_node import ControllerNode
-from swivel_car_control.odometry_node import OdometryNode
 
 JOINTS = ['swivel_joint', 'rear_left_wheel_joint', 'rear_right_wheel_joint',
           'front_left_wheel_joint', 'front_right_wheel_joint']
@@ -177,8 +179,12 @@ def test_swivel_command_and_refusal(controller):
 
 
 def test_a_sim_reset_event_restarts_the_controller_from_the_state_after_it(controller):
-    """sim/reset put the car back with the swivel at 0; the controller went on holding the
-    0.5 rad it held before and turned the swivel back to it (found by the soak)."""
+    """
+    Check a sim reset event restarts the controller from the state after it.
+
+    Found by the soak: sim/reset put the car back with the swivel at 0; the controller went on
+    holding the 0.5 rad it held before and turned the swivel back to it.
+    """
     reset = controller.probe.create_publisher(Header, 'sim/reset_event', 10)
     controller.wait_connected(reset)
     step(controller, 1.0)

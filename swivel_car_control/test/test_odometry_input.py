@@ -1,16 +1,19 @@
-"""The odometry's joint_states gate (core.odometry_input): a message it cannot trust is never
-integrated (issue 12: one wheel rate of 1e300, or one stamp of 0 s while driving, put the
-odometry metres to 1e296 m off for good)."""
+"""
+The odometry's joint_states gate (core.odometry_input) integrates no message it cannot trust.
+
+Before (issue 12), one wheel rate of 1e300, or one stamp of 0 s while driving, put the
+odometry metres to 1e296 m off for good.
+"""
 
 import math
 
-import pytest
 from hypothesis import given, settings, strategies as st
-from swivel_car_model.description import CarDescription
+import pytest
 
 from swivel_car_control.core.joint_states import JointStateOdometry
 from swivel_car_control.core.odometry_input import (
     GatedOdometry, JointStateGate, MAX_GAP, MAX_SWIVEL_RATE, Verdict, WHEEL_RATE_FACTOR)
+from swivel_car_model.description import CarDescription
 
 ROBOT = CarDescription()
 NAMES = ['swivel_joint', 'rear_left_wheel_joint', 'rear_right_wheel_joint']
@@ -92,8 +95,12 @@ stamps = st.floats(-1e10, 1e10, allow_nan=False) | st.sampled_from([math.nan, ma
 @settings(deadline=None, max_examples=300)
 @given(st.lists(stamps, max_size=30))
 def test_what_is_integrated_follows_on_in_time_or_was_confirmed(sequence):
-    """Whatever the stamps: an integrated message lies within max_gap after the last one
-    admitted; a restart follows, within max_gap, the refused message just before it."""
+    """
+    Check what is integrated follows on in time or was confirmed.
+
+    Whatever the stamps: an integrated message lies within max_gap after the last one
+    admitted; a restart follows, within max_gap, the refused message just before it.
+    """
     g = gate()
     previous, previous_verdict = None, None
     for t in sequence:
@@ -132,7 +139,7 @@ bad_stamp = (st.floats(-1e10, 10.0 - 1e-6) | st.floats(11.0 + MAX_GAP, 2.0**31)
        where=st.integers(1, 99), velocity=bad_velocity, stamp=bad_stamp,
        bad_is_stamp=st.booleans())
 def test_one_bad_message_in_a_drive_leaves_the_pose_as_without_it(rates, where, velocity,
-                                                                   stamp, bad_is_stamp):
+                                                                  stamp, bad_is_stamp):
     clean = [(10.0 + PERIOD * k, [0.0, rate, rate]) for k, rate in enumerate(rates)]
     bad = (stamp, [0.0, 1.0, 1.0]) if bad_is_stamp else (clean[where][0] - PERIOD / 2,
                                                          [0.0, velocity, 1.0])

@@ -1,20 +1,22 @@
-"""The odometry node never integrates a joint_states message it cannot trust, and says so
-(issue 12: one wheel rate of 1e300 or -1e12 with the car standing, or one stamp of 0 s,
-1 s or 2^31-1 s while driving, moved the odom 0.2 m to 1e296 m, with nothing logged)."""
+"""
+The odometry node never integrates a joint_states message it cannot trust, and says so.
+
+Before (issue 12), one wheel rate of 1e300 or -1e12 with the car standing, or one stamp of
+0 s, 1 s or 2^31-1 s while driving, moved the odom 0.2 m to 1e296 m, with nothing logged.
+"""
 
 import os
 
-import pytest
-import rclpy
 from builtin_interfaces.msg import Time
 from nav_msgs.msg import Odometry
+import pytest
 from rcl_interfaces.msg import Log
+import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from sensor_msgs.msg import JointState
+from swivel_car_control.odometry_node import OdometryNode
 from swivel_car_model.description import CarDescription
 from swivel_car_testing import next_domain_id, spin_until
-
-from swivel_car_control.odometry_node import OdometryNode
 
 NAMES = ['swivel_joint', 'rear_left_wheel_joint', 'rear_right_wheel_joint']
 R = CarDescription().model_params().r  # [m]

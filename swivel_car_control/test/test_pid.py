@@ -2,8 +2,8 @@
 
 import math
 
-import pytest
 from hypothesis import given, settings, strategies as st
+import pytest
 
 from swivel_car_control.core.pid import PidConfig, SwivelPid
 
@@ -57,8 +57,12 @@ def test_torque_always_within_clamp(set_point, measured, rate):
 
 
 def test_closed_loop_on_a_joint_settles_without_overshoot():
-    """A swivel-like joint (inertia, viscous friction, gravity-like load) under the Table 2
-    gains reaches the set point with the integral removing the load's offset."""
+    """
+    Check a swivel-like joint under the Table 2 gains reaches the set point.
+
+    The joint has inertia, viscous friction and a gravity-like load; the integral removes the
+    load's offset.
+    """
     pid = SwivelPid(CONFIG)
     inertia, friction, load = 0.05, 0.5, 2.0  # [kg m^2], [N m s/rad], [N m]
     angle = rate = 0.0

@@ -2,8 +2,8 @@
 
 import math
 
-import pytest
 from hypothesis import given, settings, strategies as st
+import pytest
 
 from swivel_car_control.core.steering import (
     SteeringMap, swivel_is_tip_safe, tip_safe_swivel_limit)

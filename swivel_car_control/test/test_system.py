@@ -1,16 +1,20 @@
-"""System test: the real executables (sim_node in lockstep, controller_node, odometry_node)
-as separate processes, driven through cmd_vel and checked against the sim's ground truth."""
+"""
+System test: the real executables as separate processes, driven through cmd_vel.
+
+The executables are sim_node in lockstep, controller_node and odometry_node; the car is
+checked against the sim's ground truth.
+"""
 
 import math
 import os
 
-import pytest
-import rclpy
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
+import pytest
+import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
-from swivel_car_testing import NodeProcess, config_path, next_domain_id, spin_until
+from swivel_car_testing import config_path, next_domain_id, NodeProcess, spin_until
 
 DEADMAN = 2.0  # [s] sim time
 
@@ -25,7 +29,11 @@ def _seconds(msg):
 
 
 def _elapsed(start, end):
-    """Sim time between two messages: a loaded driver sees the sim in uneven jumps. # [s]"""
+    """
+    Return the sim time between two messages [s].
+
+    A loaded driver sees the sim in uneven jumps.
+    """
     return _seconds(end) - _seconds(start)
 
 
@@ -60,8 +68,11 @@ class Driver:
             self.cmd_vel.publish(out)
 
     def drive(self, seconds, command):
-        """Send ``command`` (None: nothing) for ``seconds`` of sim time; return
-        (ground truth at the start, at the end)."""
+        """
+        Send ``command`` (None: nothing) for ``seconds`` of sim time.
+
+        Returns the ground truth at the start and at the end.
+        """
         self.command = command
         start = self.truth[-1]
         spin_until(self.executor, lambda: _seconds(self.truth[-1]) >= _seconds(start) + seconds,
@@ -69,9 +80,12 @@ class Driver:
         return start, self.truth[-1]
 
     def settle(self, command, seconds):
-        """Send ``command`` until the controller executes it (its limited output reaches the
-        asked yaw rate, or speed when going straight: on a loaded machine this driver trails
-        the lockstep sim), then for ``seconds`` more of sim time."""
+        """
+        Send ``command`` until the controller executes it, then for ``seconds`` more of sim time.
+
+        Executing it: its limited output reaches the asked yaw rate, or speed when going
+        straight (on a loaded machine this driver trails the lockstep sim).
+        """
         self.command = command
         index = 0 if command[1] else 1
         wanted = command[1] if command[1] else command[0]

@@ -1,7 +1,9 @@
-"""System test: the benchmark's standard routes (``swivel_car_control.benchmark.routes``)
-driven through the real executables, each its own process: sim_node in lockstep,
-controller_node, odometry_node. The odometry's end pose is checked against the sim's ground
-truth, as the benchmark does in-process.
+"""
+System test: the benchmark's standard routes driven through the real executables.
+
+The routes are ``swivel_car_control.benchmark.routes``; each executable is its own process:
+sim_node in lockstep, controller_node, odometry_node. The odometry's end pose is checked
+against the sim's ground truth, as the benchmark does in-process.
 
 The route driver acts once per controller state, like the planner: its swivel commands are
 stamped with the state they answer and the controller waits for them (the lockstep chain of
@@ -15,21 +17,20 @@ from __future__ import annotations
 import math
 import os
 
-import pytest
-import rclpy
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
+import pytest
+import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from std_srvs.srv import Empty
+from swivel_car_control.benchmark import routes, Segment
+from swivel_car_control.test.test_system import _seconds, _yaw
 from swivel_car_model.description import CarDescription
 from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ResetSimulation
 from swivel_car_testing import (
     lockstep_parameters, next_domain_id, spin_until, start_node)
-
-from swivel_car_control.benchmark import Segment, routes
-from swivel_car_control.test.test_system import _seconds, _yaw
 
 SETTLE = 1.0  # [s] sim time standing still at the end of a route, as the benchmark
 # Our odometry's end-pose error, % of the distance travelled; the in-process benchmark
@@ -104,8 +105,12 @@ class RouteDriver:
         spin_until(self.executor, lambda: self.time >= end, 30.0, what)
 
     def drive(self, segments: list[Segment]) -> tuple[Odometry, Odometry, float]:
-        """From the origin at rest: drive, then stand for SETTLE. Returns the odometry and
-        the ground truth of one moment at the end, and the distance the truth travelled."""
+        """
+        Drive ``segments`` from the origin at rest, then stand for SETTLE.
+
+        Returns the odometry and the ground truth of one moment at the end, and the distance
+        the truth travelled.
+        """
         self.call(self.reset_sim, ResetSimulation.Request(remove_obstacles=True))
         self.wait(0.3, 'the car to settle after the reset')
         self.call(self.reset_odometry, Empty.Request())
