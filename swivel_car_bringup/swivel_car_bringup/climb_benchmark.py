@@ -7,7 +7,10 @@ planner cores of the ROS nodes, in lockstep), and prints a table judged by the s
 truth: the front axle on top (the thesis' criterion) and all four wheels on top, level, at
 rest. Beside them the swivel torque (peak, measured and predicted by the model; sign changes
 while the rear axle climbs, the chatter of the old procedure), the energy, and the car-like
-baseline with the same mass layout and drive train driven straight at the same steps.
+baseline with the same mass layout and drive train driven straight at the same steps. Then
+the same table for the phi < 0 design (``swivel_car_model/config/designs/phi_negative.yaml``,
+the semi-active procedure of thesis III.B, the body colliding) at ``--phi-negative-heights``,
+from far, wide steps: its approach is 0.75-0.94 rad oblique.
 
 Requests the planner refuses before moving because of where the car stands (the top face
 too narrow for the crossing the car can reach from there) are drawn again and reported, not
@@ -29,6 +32,7 @@ import statistics
 import sys
 import time
 
+from ament_index_python.packages import get_package_share_directory
 import numpy as np
 import yaml
 
@@ -47,6 +51,8 @@ _CHATTER_TORQUE = 1.0  # [N m] torque sign changes count between values beyond +
 _CAR_LIKE_SPEED = 0.5  # [m/s] the baseline's drive speed at the step
 _CAR_LIKE_TIME = 6.0  # [s] sim time it drives
 _TARGET_HEIGHT = 0.08  # [m] the whole-car climb the product aims at (issue 11)
+PHI_NEGATIVE = (Path(get_package_share_directory('swivel_car_model')) / 'config' / 'designs'
+                / 'phi_negative.yaml')
 
 
 @dataclass(frozen=True)
@@ -333,6 +339,12 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument('--controller', action='append', metavar='NAME=VALUE',
                         help='one controller parameter, e.g. max_linear_velocity=1.0')
     parser.add_argument('--skip-car-like', action='store_true')
+    parser.add_argument('--phi-negative-heights', default='0.04,0.05,0.06,0.07,0.08',
+                        type=lambda text: [float(v) for v in text.split(',') if v],
+                        metavar='H1,H2,...',
+                        help="[m] then the phi < 0 design's table (semi-active procedure, "
+                             "config/designs/phi_negative.yaml, body colliding) at these "
+                             "heights; '' skips it")
     parser.add_argument('--write-capability', type=Path, metavar='PATH',
                         help='write the whole-car capability table the planner ships')
     args = parser.parse_args(argv)
@@ -352,6 +364,24 @@ def main(argv: list[str] | None = None) -> None:
     trials = run_swivel(args, config, ranges, rng)
     car_like = {} if args.skip_car_like else run_car_like(args, robot)
     report(trials, car_like, description)
+    if args.phi_negative_heights and not args.write_capability:
+        negative = design_values(PHI_NEGATIVE)
+        negative_started = time.monotonic()
+        print(f'\nphi < 0 design ({PHI_NEGATIVE.name}, semi-active procedure):')
+        negative_args = argparse.Namespace(**{**vars(args),
+                                              'heights': args.phi_negative_heights})
+        negative_config = StackConfig.installed(
+            robot={**robot, **negative, 'body_collision': True},
+            controller=_assignments(args.controller),
+            planner={'capability_file': 'none', **_assignments(args.planner)})
+        # Its approach is 0.75-0.94 rad oblique (the minimum approach angle, eqs. 92-100) and
+        # turns onto it on wide arcs (plan.semi_active_turn): it needs a far, wide step, or
+        # most requests are refused as placed.
+        wide = RequestRanges(2.4, 3.0, args.max_yaw, 4.0, 5.0, args.max_offset)
+        # Its own draws: the same requests whatever the default robot's table drew.
+        report(run_swivel(negative_args, negative_config, wide, random.Random(args.seed)), {},
+               CarDescription.from_values({**robot, **negative}))
+        print(f'(phi < 0 table: {time.monotonic() - negative_started:.0f} s wall)')
     if args.write_capability:
         command = 'python -m swivel_car_bringup.climb_benchmark ' + shlex.join(sys.argv[1:])
         table = table_of(trials, lambda t: t.four, description, command)

@@ -5,18 +5,18 @@ pressed against a riser helps the swivel (thesis eqs. 86-91). The sim core direc
 deterministic; docs/thesis_reproduction.md (III.B in physics) has the numbers."""
 
 import math
-import xml.etree.ElementTree as ET
 from pathlib import Path
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import pybullet
 import pytest
-import yaml
 from swivel_car_model import climbing, kinematics, planar
 from swivel_car_model.description import CarDescription
 
 from swivel_car_sim.physics import SimConfig, StepSpec, SwivelCarSim
 from swivel_car_sim.urdf import build_robot
+import yaml
 
 from .conftest import SwivelHold
 
@@ -163,8 +163,9 @@ def _contact_moments(sim: SwivelCarSim, joint: str, other: int, axis: np.ndarray
     return normal, friction, force
 
 
-def _against_riser(design: CarDescription, drive_speed: float) -> dict:
-    """The left front wheel lifted to RISER_SWIVEL in front of a 45 cm riser that only it
+def _against_riser(design: CarDescription, drive_speed: float,
+                   swivel: float = RISER_SWIVEL) -> dict:
+    """The left front wheel lifted to ``swivel`` [rad] in front of a 45 cm riser that only it
     meets, the swivel held there by a PID (its integral removes the offset a PD leaves, so
     both runs hold the same angle); then the drive pushes it against the riser (motor at its
     torque limit) or stays still. Means over the last second."""
@@ -176,7 +177,7 @@ def _against_riser(design: CarDescription, drive_speed: float) -> dict:
         log = []
         for period in range(500):
             state = sim.state()
-            set_point = min(RISER_SWIVEL, set_point + 0.015)
+            set_point = min(swivel, set_point + 0.015)
             error = set_point - state.positions[0]
             integral += error * 0.01
             torque = design.kp * error + design.ki * integral - design.kd * state.velocities[0]
@@ -220,3 +221,23 @@ def test_a_driven_wheel_against_a_riser_helps_the_swivel_more_than_eq_89_says(de
           + ', '.join(f'{k} {v:+.2f}' for k, v in changes.items()))
     assert assist == pytest.approx(contacts, abs=0.5)  # every contact accounted for
     assert assist > 2.0 * model
+
+
+def test_the_assist_falls_as_the_swivel_rises(design):
+    # The thesis' text on Figs. 50-51 says the assisting torque increases with theta2 (and
+    # that it vanishes at pi/2). Measured at a 10 N m motor, the holding torque drops by
+    # 11.5 N m at theta2 = 0.3 rad and by 3.6 N m at 1.2 rad; eq. 89, corrected, falls too
+    # (3.17 to 1.43 N m): the lever of the riser's push shrinks as the shaft turns.
+    weak = design.replace(drive_torque_limit=10.0)
+    p = weak.model_params()
+    assists, models = [], []
+    for swivel in (0.3, 1.2):
+        still = _against_riser(weak, 0.0, swivel)
+        pushed = _against_riser(weak, 5.0, swivel)
+        assists.append(still['hold'] - pushed['hold'])
+        models.append(climbing.induced_swivel_torque(
+            p, pushed['riser_force'] * p.r, pushed['theta2']))
+    print(f'assist at theta2 0.3 / 1.2 rad: {assists[0]:.2f} / {assists[1]:.2f} N m, eq. 89 '
+          f'{models[0]:.2f} / {models[1]:.2f} N m')
+    assert assists[1] < 0.5 * assists[0]
+    assert models[1] < models[0]

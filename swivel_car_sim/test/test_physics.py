@@ -10,8 +10,10 @@ from swivel_car_model.description import CarDescription
 from swivel_car_model.params import SwivelCarParams
 
 from swivel_car_sim.physics import SimConfig, StepSpec, SwivelCarSim
+import yaml
 
 from .conftest import SwivelHold
+from .test_phi_negative import DESIGN
 
 DT = 0.01  # [s] control period of SwivelHold
 SWEEP_RATE = 0.1  # [rad/s] quasi-static: the thesis' DAE uses 0.05 rad/s
@@ -34,9 +36,23 @@ def test_driving_straight_speed_is_wheel_speed_times_r(sim):
     assert abs(end.yaw) < 0.01
 
 
+def _robot(phi: float, **values) -> CarDescription:
+    """Return the default robot for phi > 0, the phi < 0 design (r = 0.19 m) for phi < 0.
+
+    Table 2's wheels with phi = -pi/3 put the apex 5 cm under the ground: the sim (no body
+    collision) drove such a car through the floor, a robot that cannot exist.
+    """
+    if phi > 0.0:
+        return CarDescription(phi=phi, **values)
+    design = CarDescription.from_values(
+        yaml.safe_load(DESIGN.read_text())['/**']['ros__parameters'])
+    assert design.phi == phi
+    return design.replace(**values)
+
+
 def _sweep(phi: float) -> dict:
     """Swivel 0 -> SWEEP_END at standstill (drive held at 0), logging every period."""
-    d = CarDescription(phi=phi)
+    d = _robot(phi)
     p = d.model_params()
     with SwivelCarSim(SimConfig(description=d)) as s:
         hold = SwivelHold(s)
@@ -122,7 +138,7 @@ def test_free_rolling_sweep_turns_like_the_dae(phi):
     # pose change. It puts the body mass at the apex' ground projection, the sim's centre of
     # mass sits at 24 % of the wheelbase (to match I_s), and free wheels let the mass layout
     # steer the translation; so only the turn is compared, within 0.1 rad.
-    d = CarDescription(phi=phi, drive_torque_limit=1e-9)
+    d = _robot(phi, drive_torque_limit=1e-9)
     p = d.model_params()
     with SwivelCarSim(SimConfig(description=d)) as s:
         hold = SwivelHold(s)
@@ -294,6 +310,8 @@ def test_bad_reset_is_refused_and_changes_nothing(sim):
     before = sim.state()
     with pytest.raises(ValueError, match='finite'):
         sim.reset(math.nan, 0.0, 0.0)
+    with pytest.raises(ValueError, match='x must be within'):
+        sim.reset(1e300, 0.0, 0.0)
     with pytest.raises(ValueError, match='overlap obstacle'):
         sim.reset(0.6, 0.0, 0.0)  # on top of the step
     after = sim.state()

@@ -60,6 +60,21 @@ point where the lifted wheel will land (``landing_point``) ``push_margin`` over 
 while the grounded wheel's contact stays short of the riser, and the set-down drives at
 ``set_down_speed``: the car pitches up about the rear axle as the wheel takes the load, and
 with the wheels held the wheel on the top slid back off the edge (measured in the sim).
+
+Semi-active lift (phi < 0, thesis III.B)
+----------------------------------------
+With phi < 0 the riser's push on a driven front wheel turns the swivel the way that lifts
+that wheel (``climbing.induced_swivel_torque``, eqs. 86-91 corrected). The approach is the
+standard one, its heading at least the minimum approach angle (eqs. 92-100) that keeps the
+steering wheel off the riser, but the lift does not wait at a standstill: the car drives on
+from ``lift_gap`` before the lifted wheel's front meets the riser (its rest contact ``a +
+lift_gap`` short of the edge) while the swivel ramps to the lift angle, so the drive presses
+the wheel against the riser and does part of the lift. No standstill lift, no drift: the
+advance arc starts where the lift starts. The rest (advance, set-down, second wheel, rear
+axle) is the standard procedure's. The push-lift is not offered (it leads with the other
+wheel). Its heading is large (0.75-0.94 rad on the phi < 0 design), so the crossing assumes
+the car turns onto it at once, as the push-lift's does, on the wider arc and after the run
+of ``semi_active_turn``, which also sets the room the approach needs.
 """
 
 from __future__ import annotations
@@ -235,8 +250,9 @@ def advance_arc(p: SwivelCarParams, config: PlannerConfig, swivel: float, side: 
     radius = 1.0 / abs(curvature) if curvature != 0.0 else math.inf  # [m]
     raise PlanError(ErrorCode.WHEEL_INTERFERENCE,
                     f'with the swivel held at {swivel:.2f} rad the lift turns the car by '
-                    f'{abs(drift_yaw):.2f} rad and the advance on a {radius:.2f} m radius: at no heading up to '
-                    f'{config.max_lead_angle:.2f} rad to the edge\'s normal does the lifted '
+                    f'{abs(drift_yaw):.2f} rad and the advance on a {radius:.2f} m radius: at '
+                    f'no heading up to {config.max_lead_angle:.2f} rad to the edge\'s normal '
+                    f'does the lifted '
                     f'wheel get over the edge with the other front wheel clear of the riser')
 
 
@@ -315,9 +331,17 @@ def _approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
     lead = max(lead_angle(p, config, height),
                float(climbing.min_approach_angle_for_step(p, height)))
     swivel = side * abs(theta2)
+    reach = math.sqrt(p.r ** 2 - (p.r - min(height, p.r)) ** 2)  # [m] see lead_angle
+    if p.phi < 0.0:
+        # Semi-active (module docstring): the lift starts lift_gap before the wheel meets the
+        # riser and goes on while driving, so there is no standstill drift.
+        lead_distance = reach + config.lift_gap
+        advance = advance_arc(p, config, swivel, side, lead, lead_distance, reach, 0.0)
+        heading = advance.end_heading - advance.turn
+        return _placed(p, config, request, side, advance, heading, lead_distance,
+                       lead_distance + p.h * abs(math.sin(heading)), turn_first=True)
     drift_x, drift_y, drift_yaw = (
         float(v) for v in dynamics.swivel_pose_drift(p, 0.0, swivel))
-    reach = math.sqrt(p.r ** 2 - (p.r - min(height, p.r)) ** 2)  # [m] see lead_angle
     # The drift's push towards the riser lengthens the advance, which turns the heading at
     # lift: twice round settles it (the drift is a few millimetres).
     lead_distance = p.r + config.lift_gap
@@ -351,6 +375,26 @@ def _push_approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequ
                    lead_distance - p.h * math.sin(config.push_lead), turn_first=True)
 
 
+_TURN_IN = 1.5  # [1] semi-active turn-in arc per tightest aligning arc (the loop's lag)
+
+
+def semi_active_turn(p: SwivelCarParams, config: PlannerConfig) -> tuple[float, float]:
+    """Return the semi-active approach's turn: the arc radius [m], the straight run before it [m].
+
+    The arc is ``_TURN_IN`` times the tightest aligning arc (``max_steer``): the heading loop
+    reaches full steering only 0.23 rad of error on: of 8 requests (6 that had failed at 1.0
+    times, 2 that had passed), 2.0 times left 3 0.16-0.26 rad off at the lift point, 1.5 times
+    2 (0.18, 0.23 rad), both of which the room this turn needs now refuses. The run is the
+    travel at ``approach_speed`` while the swivel turns to ``max_steer`` at ``swivel_rate``
+    (0.53 m on the phi < 0 design, its 0.19 m wheels): the phi < 0 swivel's move yaws the car
+    against the turn first.
+    """
+    radius = _TURN_IN * p.wheelbase / math.tan(config.max_steer)
+    delay = (config.approach_speed * p.r * abs(float(kinematics.swivel_for_steering(
+        p, config.max_steer))) / config.swivel_rate)
+    return radius, delay
+
+
 def _placed(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest, side: int,
             advance: AdvanceArc, heading: float, lead_distance: float,
             axle_normal: float, turn_first: bool = False) -> _Approach:
@@ -363,8 +407,11 @@ def _placed(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest, si
     psi_lead = advance.end_heading
 
     # Aligning turns on an arc of radius >= wheelbase / tan(max_steer); give it room.
-    turn_radius = p.wheelbase / math.tan(config.max_steer)  # [m]
-    align_run = 1.5 * turn_radius * abs(math.sin(heading) + math.sin(request.step_yaw))
+    turn_radius, delay = p.wheelbase / math.tan(config.max_steer), 0.0  # [m]
+    if p.phi < 0.0:
+        turn_radius, delay = semi_active_turn(p, config)
+    align_run = (1.5 * turn_radius * abs(math.sin(heading) + math.sin(request.step_yaw))
+                 + delay)
     available = request.step_distance * math.cos(request.step_yaw)
     error = None
     if available < axle_normal + align_run:
@@ -462,14 +509,17 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
     # Too close to turn onto the approach (or onto the crossing): backing up straight along
     # the car's x axis gives the same request with the edge further ahead.
     requested = request
-    push = height >= config.push_lift_height
+    # The push-lift leads with the grounded wheel; the semi-active lift needs the lifted one
+    # against the riser.
+    semi_active = p.phi < 0.0
+    push = not semi_active and height >= config.push_lift_height
     for backup in _backups(config.max_backup):
         request = dataclasses.replace(requested, step_distance=requested.step_distance + backup)
         try:
             approaches = _approaches(p, config, request, theta2, leading, push)
         except PlanError as error:
             # No heading keeps the other wheel off the riser: the push-lift leads with it.
-            if push or error.code != ErrorCode.WHEEL_INTERFERENCE:
+            if push or semi_active or error.code != ErrorCode.WHEEL_INTERFERENCE:
                 raise
             push = True
             approaches = _approaches(p, config, request, theta2, leading, push)
@@ -503,7 +553,7 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
                 + (p.wheelbase + 2.0 * p.h * abs(math.sin(psi_lead)) + config.rest_margin)
                 / cos_lead / v_climb)
     return ClimbPlan(
-        procedure=PROCEDURE_ACTIVE_LIFT if p.phi > 0.0 else PROCEDURE_SEMI_ACTIVE,
+        procedure=PROCEDURE_SEMI_ACTIVE if semi_active else PROCEDURE_ACTIVE_LIFT,
         swivel_angle=signed_theta2, lift_angle=theta1,
         wheel_clearance=float(kinematics.lifted_wheel_lowest_height(p, theta2)) - height,
         approach_distance=approach_distance, approach_heading=approach_heading,

@@ -10,6 +10,8 @@ action phase each one reports)::
                      onto the approach): reverse straight, the swivel at 0,
                      until the car is ``plan.backup_distance`` back            APPROACH
     APPROACH         drive to the lift point, steering to the planned heading   APPROACH
+    PRESS            semi-active only (below): drive on until the lifted wheel
+                     is stopped by the riser                                    APPROACH
     LIFT             stop; swivel to the plan's angle: the leading front wheel
                      rises above the step                                       LIFT
     ADVANCE          drive, swivel held, until that wheel is over the step      ADVANCE
@@ -25,6 +27,20 @@ action phase each one reports)::
     STOP_ON_TOP      drive 0, the swivel held where it is, until odometry says
                      the car stands and the IMU's pitch and roll have been
                      still for ``settle_time``; done if it is still level       CLIMB_REST
+
+A semi-active plan (``PROCEDURE_SEMI_ACTIVE``, phi < 0, plan module) puts PRESS between
+APPROACH and LIFT and changes LIFT: the car does not stop. PRESS drives on at ``climb_speed``,
+the swivel where it is, until the riser stops the lifted wheel (odometry speed below
+``stop_speed``; or odometry has that wheel ``lift_gap`` past where it meets the riser). LIFT
+keeps driving while the swivel ramps at ``swivel_rate`` to the plan's angle (then the outer
+loop below closes the rest), so the drive presses the wheel against the riser and its push
+does part of the lift (thesis eqs. 86-91). LIFT ends when the measured swivel is within
+``swivel_tolerance`` of that angle. Neither step is watched by NO_PROGRESS (the car stands
+at the riser by design): a wheel that never meets a riser ends PRESS by odometry, and LIFT's
+swivel headway is watched by STALL. Its APPROACH turns onto the line through the planned
+crossing no sooner than the arc of ``plan.semi_active_turn`` meets it tangentially
+(``_turn_in``), and the lift point accepts a heading up to twice ``align_tolerance`` more
+oblique than planned (the steering wheel only gets further off the riser), not less.
 
 A push-lift plan (``plan.push_lift``: the grounded wheel leads to the riser, plan module)
 changes two steps: ADVANCE ends with the point where the lifted wheel will land on the step
@@ -62,13 +78,13 @@ from dataclasses import dataclass
 from enum import Enum
 import math
 
-from swivel_car_model import kinematics
+from swivel_car_model import dynamics, kinematics
 from swivel_car_model.params import SwivelCarParams
 
 from swivel_car_planner.core.codes import ErrorCode, Phase
 from swivel_car_planner.core.config import PlannerConfig
 from swivel_car_planner.core.geometry import Pose2D, StepEdge, wrap_angle
-from swivel_car_planner.core.plan import ClimbPlan
+from swivel_car_planner.core.plan import ClimbPlan, PROCEDURE_SEMI_ACTIVE, semi_active_turn
 
 
 class Step(Enum):
@@ -77,6 +93,7 @@ class Step(Enum):
     STOP = (Phase.APPROACH, 0.0)
     BACK_UP = (Phase.APPROACH, 0.02)
     APPROACH = (Phase.APPROACH, 0.05)
+    PRESS = (Phase.APPROACH, 0.15)
     LIFT = (Phase.LIFT, 0.2)
     ADVANCE = (Phase.ADVANCE, 0.3)
     SET_DOWN = (Phase.SET_DOWN, 0.4)
@@ -175,6 +192,7 @@ class ClimbStateMachine:
         self._p = p
         self._config = config
         self._plan = plan
+        self._semi_active = plan.procedure == PROCEDURE_SEMI_ACTIVE
         self._step_distance = step_distance
         self._step_yaw = step_yaw
         self._allowance = time_allowance if time_allowance > 0.0 else config.time_allowance
@@ -267,14 +285,31 @@ class ClimbStateMachine:
             return Command(0.0, config.swivel_rate, -config.approach_speed, True)
         if step == Step.APPROACH:
             if self._lifted_wheel_distance(obs) >= -plan.lead_distance:
-                error = plan.approach_heading - self._edge.relative_heading(self._heading(obs))
-                if abs(error) > config.align_tolerance:
+                heading = self._edge.relative_heading(self._heading(obs))
+                error = plan.approach_heading - heading
+                # Semi-active: more oblique only moves the steering wheel further off the
+                # riser (the minimum approach angle is a lower bound): twice the tolerance.
+                oblique = (self._semi_active
+                           and 0.0 <= side * error <= 2.0 * config.align_tolerance)
+                if abs(error) > config.align_tolerance and not oblique:
                     return self._finish(
                         obs, ErrorCode.FAILED,
                         f'reached the lift point {error:.2f} rad off the planned heading '
                         f'(tolerance {config.align_tolerance:.2f} rad)')
-                return self._enter(Step.LIFT, obs)
+                return self._enter(Step.PRESS if self._semi_active else Step.LIFT, obs)
             return self._steer(obs, self._approach_heading(obs), config.approach_speed)
+        if step == Step.PRESS:
+            # Stopped by the riser, or odometry has the wheel lift_gap past where it meets
+            # it (it rolled up a low step by itself, or the edge is not where asked).
+            if abs(obs.speed) <= config.stop_speed or self._lifted_wheel_distance(obs) \
+                    >= -(plan.lead_distance - 2.0 * config.lift_gap):
+                return self._enter(Step.LIFT, obs)
+            return self._open_loop(self._last_command, config.climb_speed)
+        if step == Step.LIFT and self._semi_active:
+            # Drive and swivel together: the riser's push on the driven wheel helps the lift.
+            if side * obs.swivel >= side * plan.swivel_angle - config.swivel_tolerance:
+                return self._enter(Step.ADVANCE, obs)
+            return self._ramp(obs, plan.swivel_angle, config.climb_speed, then_hold=True)
         if step == Step.LIFT:
             if self._settled(obs, plan.swivel_angle):
                 return self._enter(Step.ADVANCE, obs)
@@ -412,15 +447,43 @@ class ClimbStateMachine:
         off_line = -math.sin(heading) * normal + math.cos(heading) * along  # [m] left of it
         correction = self._config.crossing_gain * off_line
         limit = self._config.max_steer
-        if plan.push_lift:
+        if self._semi_active:
+            correction = math.copysign(min(abs(correction), self._turn_in(abs(off_line))),
+                                       correction)
+        if plan.push_lift or self._semi_active:
             # Its heading is large: far off the line the car may hold the heading it has
             # and meet the line at an angle, rather than chase it at max_steer to the lift.
             limit = max(limit, abs(heading))
         return heading - min(limit, max(-limit, correction))
 
+    def _turn_in(self, off_line: float) -> float:
+        """Return the heading [rad] to a line ``off_line`` [m] away that meets it tangentially.
+
+        Straight on while the swivel turns to ``max_steer``, then on the arc
+        ``semi_active_turn`` plans with: ``R (1 - cos d) + L sin d = off_line``. The
+        semi-active approach's heading is large (0.75-0.94 rad): at ``crossing_gain`` alone the
+        car turned in 0.2 m short of its line and met it still turning, the swivel at its
+        steering limit; the phi < 0 swivel's own yaw, against the turn, delays every turn.
+        """
+        radius, delay = semi_active_turn(self._p, self._config)
+        norm = math.hypot(radius, delay)
+        return (math.acos(max(-1.0, min(1.0, (radius - off_line) / norm)))
+                - math.atan2(delay, radius))
+
     def _steer(self, obs: Observation, heading: float, drive_speed: float) -> Command:
-        """Drive at ``drive_speed`` steering towards ``heading`` (to the edge normal)."""
-        error = heading - self._edge.relative_heading(self._heading(obs))
+        """Drive at ``drive_speed`` steering towards ``heading`` (to the edge normal).
+
+        For phi < 0 the swivel's own move yaws the car against the turn it steers
+        (``dynamics.swivel_pose_drift``: 0.22 rad the other way on the phi < 0 design for a
+        0.35 rad steer), so straightening the swivel turns the car further: the loop steers
+        on the heading the car will have once the swivel is back at 0 (without it the
+        approach overshot its heading by 0.25 rad and swung on). For phi > 0 the move yaws
+        the car with the turn and is left alone.
+        """
+        current = self._edge.relative_heading(self._heading(obs))
+        if self._p.phi < 0.0:
+            current -= float(dynamics.swivel_pose_drift(self._p, 0.0, obs.swivel)[2])
+        error = heading - current
         limit = self._config.max_steer
         steering = min(limit, max(-limit, self._config.heading_gain * error))
         return self._open_loop(float(kinematics.swivel_for_steering(self._p, steering)),
@@ -433,13 +496,19 @@ class ClimbStateMachine:
         self._last_command = angle
         return Command(angle, self._config.swivel_rate, drive_speed, True, free)
 
-    def _ramp(self, obs: Observation, angle: float, drive_speed: float) -> Command:
-        """Command a ramp at ``swivel_rate`` from the swivel where the step began towards
-        ``angle`` while driving at ``drive_speed``: the set point and the command stay
-        together, so the controller keeps driving. No outer loop; the stall monitor watches
-        the measured swivel's headway on ``angle``."""
+    def _ramp(self, obs: Observation, angle: float, drive_speed: float,
+              then_hold: bool = False) -> Command:
+        """Command a ramp at ``swivel_rate`` towards ``angle`` while driving at ``drive_speed``.
+
+        From the swivel where the step began: the set point and the command stay together, so
+        the controller keeps driving. No outer loop (``then_hold``: the outer loop of ``_hold``
+        once the ramp has reached ``angle``); the stall monitor watches the measured swivel's
+        headway on ``angle``.
+        """
         since, start = self._ramp_start
         travel = self._config.swivel_rate * (obs.time - since)  # [rad]
+        if then_hold and travel >= abs(angle - start):
+            return self._hold(obs, angle, drive_speed)
         ramped = start + math.copysign(min(abs(angle - start), travel), angle - start)
         command = self._open_loop(ramped, drive_speed)
         self._goal_error = abs(angle - obs.swivel)
@@ -491,6 +560,8 @@ class ClimbStateMachine:
             Step.STOP: (abs(obs.speed), 0.0),
             Step.BACK_UP: (self._backed_up(obs), plan.backup_distance),
             Step.APPROACH: (self._lifted_wheel_distance(obs), -plan.lead_distance),
+            Step.PRESS: (self._lifted_wheel_distance(obs),
+                         -(plan.lead_distance - self._config.lift_gap)),
             Step.LIFT: (obs.swivel, plan.swivel_angle),
             Step.ADVANCE: (self._advance_distance(obs), self._advance_goal()),
             Step.SET_DOWN: (obs.swivel, plan.second_swivel_angle),
@@ -545,7 +616,7 @@ class ClimbStateMachine:
             return abs(obs.speed)
         if self._step == Step.BACK_UP:
             return self._backed_up(obs)
-        if self._step == Step.APPROACH:
+        if self._step in (Step.APPROACH, Step.PRESS):
             return self._lifted_wheel_distance(obs)
         if self._step == Step.ADVANCE:
             return self._advance_distance(obs)
