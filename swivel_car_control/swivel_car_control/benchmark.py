@@ -1,5 +1,8 @@
-"""Odometry benchmark: standard routes in the pybullet sim, odometry end-pose error against the
-ground truth, ours (tricycle with a variable offset steering wheel) beside a plain tricycle.
+"""
+Odometry benchmark: end-pose error against the ground truth on standard routes in the sim.
+
+The routes run in pybullet; ours (tricycle with a variable offset steering wheel) beside a
+plain tricycle.
 
     python -m swivel_car_control.benchmark [--routes straight_5m,turn_on_the_spot]
 
@@ -12,18 +15,17 @@ the real node executables in ``test/test_system_routes.py``). Prints; asserts no
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
 import math
 import time
-from dataclasses import dataclass
 
 import numpy as np
+from swivel_car_control.core.controller import ControllerConfig, SwivelController
 from swivel_car_model import kinematics
 from swivel_car_model.description import CarDescription
 from swivel_car_model.params import SwivelCarParams
-from swivel_car_model.planar import OffsetTricycleOdometry, arc_step, curvature_for_swivel
+from swivel_car_model.planar import arc_step, curvature_for_swivel, OffsetTricycleOdometry
 from swivel_car_sim.physics import SimConfig, SwivelCarSim
-
-from swivel_car_control.core.controller import ControllerConfig, SwivelController
 
 CONTROL_PERIOD = 0.01  # [s], as the sim node's default
 SWIVEL, REAR_LEFT, REAR_RIGHT = 0, 1, 2  # joint order of SwivelCarSim.state()
@@ -31,8 +33,11 @@ SWIVEL, REAR_LEFT, REAR_RIGHT = 0, 1, 2  # joint order of SwivelCarSim.state()
 
 @dataclass(frozen=True)
 class Segment:
-    """Hold one command for ``duration`` [s]: ``('cmd_vel', v [m/s], omega [rad/s])`` or
-    ``('swivel', angle [rad], drive_speed [rad/s])``."""
+    """
+    One command, held for ``duration`` [s].
+
+    ``('cmd_vel', v [m/s], omega [rad/s])`` or ``('swivel', angle [rad], drive_speed [rad/s])``.
+    """
 
     duration: float
     kind: str
@@ -47,7 +52,7 @@ def _circle(theta2: float, speed: float, p: SwivelCarParams) -> list[Segment]:
 
 
 def routes(p: SwivelCarParams) -> dict[str, list[Segment]]:
-    """The standard routes by name."""
+    """Return the standard routes by name."""
     return {
         'straight_5m': [Segment(5.0 / 0.4 + 0.2, 'cmd_vel', 0.4, 0.0)],
         'circle_swivel_0.3': _circle(0.3, 0.5, p),
@@ -63,9 +68,12 @@ def routes(p: SwivelCarParams) -> dict[str, list[Segment]]:
 
 
 class PlainTricycleOdometry:
-    """The comparison: a tricycle whose steering wheel sits on the centre line at the wheelbase
-    (``omega = v tan(delta) / wheelbase``), fed the same steering angle and rear wheel rates,
-    integrated the same way (exact arcs of the mean twist)."""
+    """
+    The comparison: a tricycle whose steering wheel sits on the centre line at the wheelbase.
+
+    Its yaw rate is ``omega = v tan(delta) / wheelbase``; it is fed the same steering angle and
+    rear wheel rates and integrated the same way (exact arcs of the mean twist).
+    """
 
     def __init__(self, p: SwivelCarParams) -> None:
         self._p = p
@@ -103,13 +111,15 @@ def _wrap(angle: float) -> float:
 
 
 class ClosedLoop:
-    """The sim, the controller core and both odometries, stepped in lockstep.
+    """
+    The sim, the controller core and both odometries, stepped in lockstep.
 
     Parameters
     ----------
     description : CarDescription
         The robot (default: the stack's).
     config : ControllerConfig
+
     """
 
     def __init__(self, description: CarDescription | None = None,
@@ -117,7 +127,7 @@ class ClosedLoop:
         description = description or CarDescription()
         self.p = description.model_params()
         self.config = config or ControllerConfig(cmd_vel_timeout=0.0,
-                                                   swivel_command_timeout=0.0)
+                                                 swivel_command_timeout=0.0)
         self.sim = SwivelCarSim(SimConfig(description=description))
         self.steps_per_period = round(CONTROL_PERIOD / self.sim.config.time_step)
         self.controller = SwivelController(self.p, self.config)
@@ -130,8 +140,11 @@ class ClosedLoop:
         self.sim.close()
 
     def period(self) -> tuple[object, object]:
-        """One control period: measure, update the odometries, command, step the physics.
-        Returns (state measured, controller output)."""
+        """
+        Run one control period: measure, update the odometries, command, step the physics.
+
+        Returns (state measured, controller output).
+        """
         state = self.sim.state()
         theta2 = max(-self.p.max_swivel_angle, min(self.p.max_swivel_angle,
                                                    float(state.positions[SWIVEL])))

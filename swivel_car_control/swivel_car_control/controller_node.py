@@ -1,5 +1,8 @@
-"""controller_node: swivel PID, cmd_vel and swivel_command handling, one ActuatorCommand per
-joint_states message (the lockstep protocol of docs/architecture.md)."""
+"""
+controller_node: swivel PID, cmd_vel and swivel_command handling.
+
+One ActuatorCommand per joint_states message (the lockstep protocol of docs/architecture.md).
+"""
 
 from __future__ import annotations
 
@@ -14,12 +17,11 @@ from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
-from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
-
 from swivel_car_control.conversions import is_zero_stamp, stamp_to_seconds
 from swivel_car_control.core.controller import ControllerConfig, SwivelController
 from swivel_car_control.core.joint_states import JointStateController
 from swivel_car_control.joints import MissingJointError
+from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
 from swivel_car_ros.ros_params import (
     declare_dataclass, declare_description, live_parameters, run_node)
 
@@ -113,8 +115,11 @@ class ControllerNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9  # [s]
 
     def _cmd_vel_time(self, stamp) -> float:
-        """A cmd_vel stamp in seconds of the node clock; a zero stamp or one from another
-        clock counts as now. # [s]"""
+        """
+        Return a cmd_vel stamp in seconds of the node clock [s].
+
+        A zero stamp or one from another clock counts as now.
+        """
         now = self._now()
         seconds = stamp_to_seconds(stamp)
         if is_zero_stamp(stamp):
@@ -187,8 +192,12 @@ class ControllerNode(Node):
                                'command')
 
     def _must_wait(self, msg: JointState) -> bool:
-        """Lockstep with a stamped swivel_command held: ``msg`` waits for the command that
-        answers the previous joint_states (the planner's pipeline is one cycle deep)."""
+        """
+        Tell whether ``msg`` waits for the command that answers the previous joint_states.
+
+        It does in lockstep with a stamped swivel_command held (the planner's pipeline is one
+        cycle deep).
+        """
         last_time = self._joint_states.last_time  # [s] of the last joint_states answered
         if (not self._lockstep_swivel_command or self._planner_late or last_time is None
                 or self._core.swivel_command is None or not self._held_stamped):

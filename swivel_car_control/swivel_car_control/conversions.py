@@ -9,7 +9,7 @@ from swivel_car_control.core.joint_states import yaw_quaternion
 
 
 def stamp_to_seconds(stamp: Time) -> float:
-    """builtin_interfaces/Time to seconds. # [s]"""
+    """Convert a builtin_interfaces/Time to seconds [s]."""
     return stamp.sec + stamp.nanosec * 1e-9
 
 

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 from typing import Sequence
 
 
@@ -20,14 +20,18 @@ class MissingJointError(ValueError):
 
 
 class JointReader:
-    """Extracts wanted joints by name; fills in a missing or non-finite velocity from the
-    change of position since the previous sample, unwrapping continuous joints (wheels)
-    whose positions a driver may report wrapped to (-pi, pi].
+    """
+    A reader of wanted joints by name.
+
+    It fills in a missing or non-finite velocity from the change of position since the
+    previous sample, unwrapping continuous joints (wheels) whose positions a driver may
+    report wrapped to (-pi, pi].
 
     Parameters
     ----------
     names : sequence of str
         Joints to read.
+
     """
 
     def __init__(self, names: Sequence[str]) -> None:
@@ -44,7 +48,8 @@ class JointReader:
 
     def read(self, t: float, names: Sequence[str], positions: Sequence[float],
              velocities: Sequence[float]) -> dict[str, JointSample]:
-        """Samples of the wanted joints at time ``t`` [s].
+        """
+        Return the samples of the wanted joints at time ``t`` [s].
 
         Raises
         ------
@@ -52,6 +57,7 @@ class JointReader:
             A wanted joint is absent or its position is not finite (nothing is remembered), or
             it has no velocity and no earlier sample to difference against (its position is
             remembered for the next message).
+
         """
         layout = tuple(names)
         if layout != self._layout:

@@ -1,17 +1,20 @@
-"""The sim node: the pybullet swivel car behind the topics a motor driver board and an IMU
-would offer, owner of /clock, with a deterministic lockstep mode (docs/architecture.md)."""
+"""
+The sim node: the pybullet swivel car behind the topics of a motor driver board and an IMU.
+
+It owns /clock and has a deterministic lockstep mode (docs/architecture.md).
+"""
 
 from __future__ import annotations
 
 import sys
 import time
 
+from nav_msgs.msg import Odometry
+from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.time import Time
-from rcl_interfaces.msg import ParameterDescriptor
 from rosgraph_msgs.msg import Clock as ClockMsg
-from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import Header
 from std_srvs.srv import SetBool
@@ -19,7 +22,6 @@ from swivel_car_msgs.msg import ActuatorCommand
 from swivel_car_msgs.srv import (RemoveObstacle, ResetSimulation, SpawnObstacle,
                                  StepSimulation)
 from swivel_car_ros.ros_params import run_node
-
 from swivel_car_sim.config import PARAMETERS, SimNodeConfig
 from swivel_car_sim.conversions import sim_time_msg, StateMessages
 from swivel_car_sim.physics import MAX_STEPS_PER_CALL, StepSpec, SwivelCarSim
@@ -177,10 +179,14 @@ class SimNode(Node):
             self._advance_when_due()
 
     def _stale(self, stamp) -> bool:
-        """A free-running sim drops a command computed more than ``watchdog_timeout`` of sim
+        """
+        Tell whether a command stamped ``stamp`` is too old to apply.
+
+        A free-running sim drops a command computed more than ``watchdog_timeout`` of sim
         time ago: it answers a state that old, and applying it steers open loop (at
         ``real_time_factor`` 0 the controller falls 20x behind and the car spins). The watchdog
-        then stops the car. An unstamped command (stamp 0) counts as fresh."""
+        then stops the car. An unstamped command (stamp 0) counts as fresh.
+        """
         watchdog = self.config.physics.watchdog_timeout
         computed = Time.from_msg(stamp).nanoseconds
         age = (self.sim.steps * self._time_step_ns - computed) * 1e-9  # [s]

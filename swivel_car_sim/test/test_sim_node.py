@@ -4,22 +4,21 @@ import math
 import os
 import time
 
+from builtin_interfaces.msg import Time
+from nav_msgs.msg import Odometry
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from builtin_interfaces.msg import Time
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
-from nav_msgs.msg import Odometry
 from std_msgs.msg import Header
 from std_srvs.srv import SetBool
 from swivel_car_msgs.msg import ActuatorCommand, StepObstacle
 from swivel_car_msgs.srv import RemoveObstacle, ResetSimulation, SpawnObstacle, StepSimulation
-from swivel_car_testing import next_domain_id, spin_until
-
 from swivel_car_sim.sim_node import SimNode
+from swivel_car_testing import next_domain_id, spin_until
 
 TIMEOUT = 20.0  # [s] wall guard against a hang, not a measurement
 
@@ -29,8 +28,11 @@ def _ns(stamp) -> int:
 
 
 class Harness:
-    """A SimNode and a client node on one executor, in a fresh ROS domain and a namespace
-    of their own (other test runs on this machine may share the domain)."""
+    """
+    A SimNode and a client node on one executor, in a fresh ROS domain and their own namespace.
+
+    The namespace because other test runs on this machine may share the domain.
+    """
 
     count = 0
 
@@ -218,13 +220,13 @@ def test_pause_stops_free_running_and_step_moves_it(harness_factory):
 
 
 @pytest.mark.parametrize('change, message', [
-    (dict(height=math.nan), 'height must be finite'), (dict(height=-0.1), 'height'),
-    (dict(distance=0.0, height=0.05), 'overlap'), (dict(yaw=2.0), 'yaw')])
+    ({'height': math.nan}, 'height must be finite'), ({'height': -0.1}, 'height'),
+    ({'distance': 0.0, 'height': 0.05}, 'overlap'), ({'yaw': 2.0}, 'yaw')])
 def test_bad_spawn_is_refused_with_a_message_and_changes_nothing(harness_factory, change,
-                                                                   message):
+                                                                 message):
     h = harness_factory(lockstep=True, lockstep_timeout=0.0)
-    fields = dict(name='', height=0.05, depth=0.5, width=1.0, distance=0.3, yaw=0.0,
-                  friction=1.0)
+    fields = {'name': '', 'height': 0.05, 'depth': 0.5, 'width': 1.0, 'distance': 0.3,
+              'yaw': 0.0, 'friction': 1.0}
     fields.update(change)
     response = h.call(SpawnObstacle, 'spawn_obstacle',
                       SpawnObstacle.Request(obstacle=StepObstacle(**fields)))
@@ -257,9 +259,12 @@ def test_spawn_remove_and_reset_services(harness_factory):
 
 def test_reset_announces_the_first_state_of_the_new_world_and_drops_older_commands(
         harness_factory):
-    """A controller learns of a reset from sim/reset_event, heard before the state it names;
-    that state has a stamp of its own, so the answer to a state before the reset (still on
-    its way) is dropped, not applied to the reset car."""
+    """
+    A controller learns of a reset from sim/reset_event, heard before the state it names.
+
+    That state has a stamp of its own, so the answer to a state before the reset (still on its
+    way) is dropped, not applied to the reset car.
+    """
     h = harness_factory(lockstep=True, lockstep_timeout=0.0)
     heard = []
     h.client.create_subscription(Header, 'sim/reset_event',

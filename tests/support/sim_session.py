@@ -1,4 +1,5 @@
-"""The whole stack in the real pybullet sim, for system tests and the benchmark.
+"""
+The whole stack in the real pybullet sim, for system tests and the benchmark.
 
 ``SimSession`` starts sim_node (lockstep), controller_node, odometry_node and planner_node as
 processes on a fresh ROS domain, each with its package's installed config, and gives an
@@ -23,6 +24,7 @@ from swivel_car_model.description import CarDescription
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
+from swivel_car_planner.ground_truth import GroundTruth
 
 try:
     from swivel_car_testing import next_domain_id, spin_until
@@ -30,16 +32,15 @@ except ImportError:  # outside pytest: the repository's helpers (pytest.ini puts
     _REPO = Path(__file__).resolve().parents[2]
     sys.path += [str(_REPO / 'scripts'), str(_REPO / 'tests' / 'support')]
     from swivel_car_testing import next_domain_id, spin_until
-from swivel_car_stack import NodeProcess, lockstep_parameters, start_node
-
-from swivel_car_planner.ground_truth import GroundTruth  # noqa: F401  (re-exported)
+from swivel_car_stack import lockstep_parameters, NodeProcess, start_node
 
 CLIMB_WALL_LIMIT = 600.0  # [s] guard against a hung stack, not a measurement
 LOCKSTEP_TIMEOUT = 2.0  # [s] wall
 
 
 class SimSession:
-    """The stack on its own ROS domain, and a client node to drive it.
+    """
+    The stack on its own ROS domain, and a client node to drive it.
 
     Parameters
     ----------
@@ -51,6 +52,7 @@ class SimSession:
         Start planner_node (the car-like baseline is driven with cmd_vel only).
     sim_parameters : mapping
         ``-p`` overrides for sim_node, on top of the lockstep ones (e.g. ``start_paused``).
+
     """
 
     def __init__(self, robot_variant: str = 'swivel',
@@ -58,8 +60,12 @@ class SimSession:
                  planner: bool = True,
                  sim_parameters: dict[str, Any] | None = None,
                  robot_parameters: dict[str, Any] | None = None) -> None:
-        """``robot_parameters``: robot description values for every node (a design file's
-        ``ros__parameters``); unset = the installed configs' description."""
+        """
+        Start the stack and the client node.
+
+        ``robot_parameters``: robot description values for every node (a design file's
+        ``ros__parameters``); unset = the installed configs' description.
+        """
         self.domain_id = next_domain_id()
         robot = dict(robot_parameters or {})
         description = CarDescription.from_values(robot)
@@ -151,8 +157,11 @@ class SimSession:
         return future.result()
 
     def reset(self, x: float = 0.0, y: float = 0.0, yaw: float = 0.0) -> None:
-        """Robot back at rest at the pose, swivel at 0, obstacles removed, odometry zeroed
-        (the controller starts afresh from the reset state: sim/reset_event)."""
+        """
+        Put the robot back at rest at the pose, swivel at 0, obstacles removed, odometry zeroed.
+
+        The controller starts afresh from the reset state (sim/reset_event).
+        """
         response = self.call(self.reset_client, ResetSimulation.Request(
             x=x, y=y, yaw=yaw, remove_obstacles=True))
         if not response.success:
@@ -182,14 +191,17 @@ class SimSession:
 
     def climb(self, height: float, distance: float, yaw: float = 0.0,
               plan_only: bool = False, width: float = 0.0) -> ClimbStep.Response:
-        """The climb_step service call users make; returns when the climb ends."""
+        """Call the climb_step service as users do; return when the climb ends."""
         return self.call(self.climb_client, ClimbStep.Request(
             step_height=height, step_distance=distance, step_yaw=yaw, plan_only=plan_only,
             step_width=width), timeout=CLIMB_WALL_LIMIT)
 
     def drive_straight(self, drive_speed: float, seconds: float) -> None:
-        """Hold the steering at 0 and drive for ``seconds`` of sim time, then stop. The
-        command is repeated within the controller's swivel_command deadman."""
+        """
+        Hold the steering at 0 and drive for ``seconds`` of sim time, then stop.
+
+        The command is repeated within the controller's swivel_command deadman.
+        """
         for speed, duration in ((drive_speed, seconds), (0.0, 0.5)):
             end = self.time + duration
             while self.time < end:

@@ -1,4 +1,5 @@
-"""The swivel car controller: command arbitration, limits, deadman, tip-over guard and PID.
+"""
+The swivel car controller: command arbitration, limits, deadman, tip-over guard and PID.
 
 One ``step`` per measured joint state gives one actuator command (swivel torque, drive speed);
 ``set_cmd_vel`` and ``set_swivel_command`` take the operator's and the planner's commands and
@@ -7,17 +8,16 @@ raise ``ValueError`` (changing nothing) for commands they refuse.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, fields, replace
+import math
 from typing import ClassVar
-
-from swivel_car_model.params import SwivelCarParams
 
 from swivel_car_control.core.limits import SlewLimiter, steering_speed_scale
 from swivel_car_control.core.pid import PidConfig, PidOutput, SwivelPid
 from swivel_car_control.core.steering import (
     SteeringMap, swivel_is_tip_safe, tip_safe_swivel_limit)
 from swivel_car_model import planar
+from swivel_car_model.params import SwivelCarParams
 
 SOURCE_CMD_VEL = 'cmd_vel'
 SOURCE_SWIVEL_COMMAND = 'swivel_command'
@@ -26,7 +26,8 @@ SOURCE_HOLD = 'hold'
 
 @dataclass(frozen=True)
 class ControllerConfig:
-    """Limits and behaviour of the controller (the PID gains live in ``SwivelCarParams``).
+    """
+    Limits and behaviour of the controller (the PID gains live in ``SwivelCarParams``).
 
     Parameters
     ----------
@@ -55,6 +56,7 @@ class ControllerConfig:
         which it stops; cos(error) between. # [rad]
     tip_over_margin : float
         Margin on thesis eq. 72: ``(pi - phi)/2 - theta1 >= tip_over_margin``. # [rad]
+
     """
 
     max_torque: float = 30.0  # [N m]
@@ -120,7 +122,8 @@ class ControlOutput:
 
 
 class SwivelController:
-    """Controller core; see the module docstring.
+    """
+    Controller core; see the module docstring.
 
     Parameters
     ----------
@@ -132,6 +135,7 @@ class SwivelController:
     ------
     ValueError
         The tip-over rule unsatisfiable.
+
     """
 
     def __init__(self, p: SwivelCarParams, config: ControllerConfig) -> None:
@@ -156,17 +160,20 @@ class SwivelController:
 
     @property
     def swivel_command(self) -> SwivelCommandRequest | None:
-        """The planner's command being held, if any."""
+        """Return the planner's command being held, if any."""
         return self._swivel_command
 
     def reconfigure(self, config: ControllerConfig) -> None:
-        """Go on with ``config``, which may differ from the current one only in
-        ``ControllerConfig.LIVE``.
+        """
+        Go on with ``config``, which may differ from the current one only in its live fields.
+
+        Those are ``ControllerConfig.LIVE``.
 
         Raises
         ------
         ValueError
             Another field differs; nothing changes.
+
         """
         fixed = [f.name for f in fields(config) if f.name not in config.LIVE
                  and getattr(config, f.name) != getattr(self.config, f.name)]
@@ -175,16 +182,19 @@ class SwivelController:
         self.config = config
 
     def reset(self, t: float) -> None:
-        """The world was reset at time ``t`` [s] (the sim's ``~/reset``: the car put back at
-        rest, swivel 0): the commands given so far are dropped now, and the first step at
-        ``t`` or later starts afresh from the swivel measured then, held with the drive
-        stopped until a new command comes. Steps of earlier times (states from before the
-        reset, still on their way) go on as before.
+        """
+        Start afresh after a reset of the world at time ``t`` [s].
+
+        The sim's ``~/reset`` put the car back at rest, swivel 0: the commands given so far
+        are dropped now, and the first step at ``t`` or later starts afresh from the swivel
+        measured then, held with the drive stopped until a new command comes. Steps of
+        earlier times (states from before the reset, still on their way) go on as before.
 
         Raises
         ------
         ValueError
             ``t`` is not finite; nothing changes.
+
         """
         if not math.isfinite(t):
             raise ValueError(f'reset time must be finite, got {t!r}')
@@ -192,12 +202,14 @@ class SwivelController:
         self._restart_at = float(t)
 
     def set_cmd_vel(self, v: float, omega: float, stamp: float) -> None:
-        """Take a velocity command: v [m/s], omega [rad/s], stamp [s] (its time).
+        """
+        Take a velocity command: v [m/s], omega [rad/s], stamp [s] (its time).
 
         Raises
         ------
         ValueError
             A field is not finite; the last command stays.
+
         """
         for name, value in (('linear.x', v), ('angular.z', omega), ('stamp', stamp)):
             if not math.isfinite(value):
@@ -207,16 +219,18 @@ class SwivelController:
 
     def set_swivel_command(self, angle: float, max_rate: float, drive_speed: float,
                            hold: bool, stamp: float, free: bool = False) -> None:
-        """Take the planner's direct command, received at ``stamp`` [s] (the deadman's
-        reference); ``hold=False`` releases it to cmd_vel. ``free`` lets the swivel turn
-        with no torque (``angle`` unused) while it stays within the tip-safe limit, where it
-        is held.
+        """
+        Take the planner's direct command, received at ``stamp`` [s] (the deadman's reference).
+
+        ``hold=False`` releases it to cmd_vel. ``free`` lets the swivel turn with no torque
+        (``angle`` unused) while it stays within the tip-safe limit, where it is held.
 
         Raises
         ------
         ValueError
             Non-finite field, angle beyond the swivel limit, negative rate, or an angle that
             breaks the tip-over rule with the margin; the previous command stays.
+
         """
         if not hold:
             self._swivel_command = None
@@ -243,10 +257,13 @@ class SwivelController:
                                                     bool(free))
 
     def step(self, t: float, measured: float, measured_rate: float) -> ControlOutput:
-        """One control period at time ``t`` [s] with the measured swivel angle [rad] and rate
-        [rad/s]. Time going backwards (a restarted sim) restarts the controller's memory and
-        drops the commands given before: they belong to the old run. So does the first step
-        at or after a ``reset`` time, keeping the commands given since the reset.
+        """
+        Run one control period at time ``t`` [s] with the measured swivel angle and rate.
+
+        The angle is in [rad], the rate in [rad/s]. Time going backwards (a restarted sim)
+        restarts the controller's memory and drops the commands given before: they belong to
+        the old run. So does the first step at or after a ``reset`` time, keeping the commands
+        given since the reset.
 
         The deadmans count in the time of these steps, whatever clock stamped a command: a
         command stamped later than ``t`` (another clock, a /clock far ahead, a runtime
@@ -328,7 +345,8 @@ class SwivelController:
                              omega_out, timed_out, command_timed_out)
 
     def _tightest_turn_speed(self, omega: float, measured: float) -> float:
-        """Forward speed [m/s] giving the yaw rate ``omega`` [rad/s] at the *measured* swivel.
+        """
+        Forward speed [m/s] giving the yaw rate ``omega`` [rad/s] at the *measured* swivel.
 
         Near the swivel limit the curvature is steep in theta2 (4.2 1/m at 1.40 rad, 4.5 at
         1.41 with the default geometry), so the few hundredths of a radian the swivel sits off

@@ -1,4 +1,5 @@
-"""What the controller and odometry nodes do with one ``joint_states`` message, ROS-free.
+"""
+What the controller and odometry nodes do with one ``joint_states`` message, ROS-free.
 
 The nodes call these on the message's fields (stamp in seconds, names, positions,
 velocities); the in-process stack (``swivel_car_bringup.inprocess``) calls them on the sim
@@ -10,11 +11,10 @@ from __future__ import annotations
 import math
 from typing import Sequence
 
-from swivel_car_model.params import SwivelCarParams
-from swivel_car_model.planar import OffsetTricycleOdometry
-
 from swivel_car_control.core.controller import ControlOutput, SwivelController
 from swivel_car_control.joints import JointReader, JointSample
+from swivel_car_model.params import SwivelCarParams
+from swivel_car_model.planar import OffsetTricycleOdometry
 
 # 'swivel': the offset tricycle's steering constraint (thesis II.E); 'rear_wheels': the yaw
 # rate from the rear wheels' rate difference (the speed from the model in both cases).
@@ -29,14 +29,18 @@ def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
 
 
 class JointStateController:
-    """The controller's answer to one ``joint_states``: the swivel joint read by name (its
-    rate differenced from positions when not reported), then one ``SwivelController.step``.
+    """
+    The controller's answer to one ``joint_states``.
+
+    The swivel joint read by name (its rate differenced from positions when not reported),
+    then one ``SwivelController.step``.
 
     Parameters
     ----------
     core : SwivelController
     swivel_joint : str
         Name of the swivel (or steering) joint in the message.
+
     """
 
     def __init__(self, core: SwivelController, swivel_joint: str) -> None:
@@ -47,27 +51,34 @@ class JointStateController:
         self._reset_at: float | None = None  # [s] time of a world reset not yet answered
 
     def reset(self, t: float) -> None:
-        """The world was reset at time ``t`` [s]: ``SwivelController.reset``, and the
-        positions read before it are not differenced against the states from ``t`` on.
+        """
+        Start afresh after a reset of the world at time ``t`` [s].
+
+        As ``SwivelController.reset``; also, the positions read before it are not differenced
+        against the states from ``t`` on.
 
         Raises
         ------
         ValueError
             ``t`` is not finite; nothing changes.
+
         """
         self.core.reset(t)
         self._reset_at = t
 
     def answer(self, t: float, names: Sequence[str], positions: Sequence[float],
                velocities: Sequence[float]) -> tuple[JointSample, ControlOutput]:
-        """The swivel sample and the control output for the state of time ``t`` [s]
-        (positions [rad], velocities [rad/s], in the order of ``names``). Time going back
+        """
+        Return the swivel sample and the control output for the state of time ``t`` [s].
+
+        Positions [rad] and velocities [rad/s] are in the order of ``names``. Time going back
         (a restarted sim) or reaching a ``reset`` time forgets the previous positions.
 
         Raises
         ------
         swivel_car_control.joints.MissingJointError
             No usable swivel reading; nothing was stepped (answer with zero torque and drive).
+
         """
         if (self.last_time is not None and t < self.last_time) or (
                 self._reset_at is not None and t >= self._reset_at):
@@ -79,9 +90,11 @@ class JointStateController:
 
 
 class JointStateOdometry:
-    """Offset-tricycle odometry (``OffsetTricycleOdometry``) fed from ``joint_states``, and
-    when to publish it: by joint_states time, at most one message per state, so that in a
-    lockstep sim every run publishes the same poses.
+    """
+    Offset-tricycle odometry (``OffsetTricycleOdometry``) fed from ``joint_states``.
+
+    It also decides when to publish: by joint_states time, at most one message per state, so
+    that in a lockstep sim every run publishes the same poses.
 
     Parameters
     ----------
@@ -92,6 +105,7 @@ class JointStateOdometry:
         One of ``YAW_RATE_SOURCES``.
     publish_rate : float
         Odometry messages per second of joint_states time, > 0. # [Hz]
+
     """
 
     def __init__(self, car: SwivelCarParams, swivel_joint: str, rear_left_wheel_joint: str,
@@ -113,8 +127,10 @@ class JointStateOdometry:
 
     def update(self, t: float, names: Sequence[str], positions: Sequence[float],
                velocities: Sequence[float]) -> bool:
-        """Integrate the state of time ``t`` [s] (positions [rad], velocities [rad/s] in the
-        order of ``names``); returns whether an odometry message is due now. Time going back
+        """
+        Integrate the state of time ``t`` [s]; return whether an odometry message is due now.
+
+        Positions [rad] and velocities [rad/s] are in the order of ``names``. Time going back
         (a sim reset) restarts the integration, the pose kept.
 
         Raises
@@ -123,6 +139,7 @@ class JointStateOdometry:
             A joint is missing; the odometry is not updated.
         ValueError
             The model refuses the values; the odometry is not updated.
+
         """
         if self.last_time is not None and t < self.last_time:
             self._joints.reset()

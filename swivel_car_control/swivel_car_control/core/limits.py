@@ -6,7 +6,8 @@ import math
 
 
 class SlewLimiter:
-    """Clamps a signal to ``+-max_value`` and its rate of change to ``max_rate``.
+    """
+    Clamps a signal to ``+-max_value`` and its rate of change to ``max_rate``.
 
     Parameters
     ----------
@@ -16,6 +17,7 @@ class SlewLimiter:
         Largest |d output / dt|, > 0 (inf: no rate limit). # [unit/s]
     initial : float
         Starting output. # [unit]
+
     """
 
     def __init__(self, max_value: float, max_rate: float, initial: float = 0.0) -> None:
@@ -36,7 +38,8 @@ class SlewLimiter:
         self.value = self._clamp(value)
 
     def step(self, target: float, dt: float, max_rate: float | None = None) -> float:
-        """Move towards ``target`` for ``dt`` seconds; returns the new output.
+        """
+        Move towards ``target`` for ``dt`` seconds; returns the new output.
 
         ``max_rate`` overrides the configured rate for this step (e.g. a planner's move rate).
         """
@@ -50,7 +53,8 @@ class SlewLimiter:
 
 
 def steering_speed_scale(error: float, full_below: float, stop_above: float) -> float:
-    """Drive speed factor while the swivel is away from its target.
+    """
+    Drive speed factor while the swivel is away from its target.
 
     1 for ``|error| <= full_below``, ``cos(error)`` up to ``stop_above``, 0 beyond (as
     ros2_controllers' tricycle_controller, which keeps 0.01 there; we stop).
@@ -61,6 +65,7 @@ def steering_speed_scale(error: float, full_below: float, stop_above: float) -> 
         Swivel target minus measured angle. # [rad]
     full_below, stop_above : float
         Thresholds, ``0 <= full_below <= stop_above <= pi/2``. # [rad]
+
     """
     magnitude = abs(error)
     if magnitude <= full_below:

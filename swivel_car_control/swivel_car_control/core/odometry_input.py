@@ -1,4 +1,5 @@
-"""Which ``joint_states`` messages the odometry may integrate, ROS-free.
+"""
+Which ``joint_states`` messages the odometry may integrate, ROS-free.
 
 One message with a wild velocity or stamp moved the odometry for good (issue 12: a wheel
 rate of 1e300 once, or one stamp of 0 s while driving, put it metres to 1e296 m off). The
@@ -15,9 +16,9 @@ the jumped one; then the integration restarts from that next message, the pose k
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import enum
 import math
-from dataclasses import dataclass
 from typing import Mapping, Sequence
 
 from swivel_car_control.core.joint_states import JointStateOdometry
@@ -51,7 +52,8 @@ class Admission:
 
 
 class JointStateGate:
-    """Admits ``joint_states`` messages to the odometry (see the module docstring).
+    """
+    Admits ``joint_states`` messages to the odometry (see the module docstring).
 
     Parameters
     ----------
@@ -59,6 +61,7 @@ class JointStateGate:
         Largest believable |velocity| of each joint the odometry reads, > 0. # [rad/s]
     max_gap : float
         Longest stamp gap integrated across, > 0. # [s]
+
     """
 
     def __init__(self, max_rates: Mapping[str, float], max_gap: float = MAX_GAP) -> None:
@@ -74,9 +77,13 @@ class JointStateGate:
         self._jumped_to: float | None = None  # [s] stamp of a refused jump, to confirm
 
     def admit(self, t: float, names: Sequence[str], velocities: Sequence[float]) -> Admission:
-        """Whether to integrate the message of time ``t`` [s] with ``velocities`` [rad/s] in
-        the order of ``names`` (an empty or short list, or a NaN, is a velocity not reported:
-        the odometry differences positions instead). An admitted message becomes the last."""
+        """
+        Decide whether to integrate the message of time ``t`` [s].
+
+        Its ``velocities`` [rad/s] are in the order of ``names`` (an empty or short list, or a
+        NaN, is a velocity not reported: the odometry differences positions instead). An
+        admitted message becomes the last.
+        """
         jumped_to, self._jumped_to = self._jumped_to, None  # only the next message confirms
         if not math.isfinite(t):
             return Admission(Verdict.REFUSE, f'stamp {t!r} s is not finite')
@@ -111,14 +118,17 @@ class JointStateGate:
 
 
 class GatedOdometry:
-    """``JointStateOdometry`` behind a ``JointStateGate``: what the odometry node does with
-    one ``joint_states`` message.
+    """
+    ``JointStateOdometry`` behind a ``JointStateGate``.
+
+    What the odometry node does with one ``joint_states`` message.
 
     Parameters
     ----------
     odometry : JointStateOdometry
     max_rates : mapping of str to float
         As for ``JointStateGate``. # [rad/s]
+
     """
 
     def __init__(self, odometry: JointStateOdometry, max_rates: Mapping[str, float]) -> None:
@@ -127,13 +137,16 @@ class GatedOdometry:
 
     def update(self, t: float, names: Sequence[str], positions: Sequence[float],
                velocities: Sequence[float]) -> tuple[Admission, bool]:
-        """The gate's answer for the message of time ``t`` [s] and whether an odometry
-        message is due now (never for a message not integrated).
+        """
+        Return the gate's answer for the message of time ``t`` [s] and whether to publish now.
+
+        An odometry message is never due for a message not integrated.
 
         Raises
         ------
         ValueError
             As ``JointStateOdometry.update`` (an admitted message it cannot use).
+
         """
         last_time = self.gate.last_time
         admission = self.gate.admit(t, names, velocities)

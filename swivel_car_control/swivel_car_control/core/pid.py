@@ -1,4 +1,5 @@
-"""PID on the swivel angle (thesis eq. 26, corrected).
+"""
+PID on the swivel angle (thesis eq. 26, corrected).
 
 Thesis eq. 26 reads ``tau = Kp (theta_2d - theta_2) + K_D theta_2_dot + K_I int(e)``: with
 positive K_D the ``+K_D theta_2_dot`` term pushes the joint further in the direction it already
@@ -8,13 +9,14 @@ measurement (not on the error), so a set-point step gives no torque kick.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 
 
 @dataclass(frozen=True)
 class PidConfig:
-    """Gains and limits of the swivel PID.
+    """
+    Gains and limits of the swivel PID.
 
     Parameters
     ----------
@@ -33,6 +35,7 @@ class PidConfig:
         > 0 (inf: always): during large moves (the set point ramping away) it would only wind
         up. Once the set point rests it always integrates: a gravity load larger than
         kp * integral_band must not leave the swivel short of its target. # [rad]
+
     """
 
     kp: float
@@ -55,7 +58,7 @@ class PidConfig:
 
 @dataclass(frozen=True)
 class PidOutput:
-    """One PID step's result. # all [N m] but ``saturated``"""
+    """One PID step's result, all in [N m] but ``saturated``."""
 
     torque: float
     p_term: float
@@ -65,7 +68,8 @@ class PidOutput:
 
 
 class SwivelPid:
-    """PID with derivative on measurement, output clamp and conditional-integration anti-windup.
+    """
+    PID with derivative on measurement, output clamp and conditional-integration anti-windup.
 
     The integral only grows while the set point rests or the error is inside
     ``integral_band``, and while the clamped output is not pushing against its limit in the
@@ -82,7 +86,8 @@ class SwivelPid:
 
     def step(self, set_point: float, measured: float, measured_rate: float,
              dt: float, set_point_moving: bool = False) -> PidOutput:
-        """Torque for one control period.
+        """
+        Torque for one control period.
 
         Parameters
         ----------
@@ -94,6 +99,7 @@ class SwivelPid:
             Time since the previous step, >= 0 (0: no integration). # [s]
         set_point_moving : bool
             The set point is still on its way (a rate limiter ramping it).
+
         """
         for name, value in (('set_point', set_point), ('measured', measured),
                             ('measured_rate', measured_rate), ('dt', dt)):

@@ -1,4 +1,5 @@
-"""Velocity command (v, omega) to swivel angle and drive speed, through the model's inverse.
+"""
+Velocity command (v, omega) to swivel angle and drive speed, through the model's inverse.
 
 What "turn on the spot" means for this drive train: one motor drives both axles through open
 differentials, so base_link's speed ``v`` is set by the drive and the only other input is the
@@ -15,8 +16,8 @@ small circle.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 
 import numpy as np
 from swivel_car_model import kinematics, planar
@@ -25,7 +26,8 @@ from swivel_car_model.params import SwivelCarParams
 
 def tip_safe_swivel_limit(p: SwivelCarParams, swivel_limit: float, margin: float,
                           samples: int = 2001) -> float:
-    """Largest swivel limit up to ``swivel_limit`` at which thesis eq. 72 holds with a margin.
+    """
+    Largest swivel limit up to ``swivel_limit`` at which thesis eq. 72 holds with a margin.
 
     Eq. 72, ``phi/2 + theta1 < pi/2``, with the lift angle ``theta1(theta2)`` from the model,
     must hold with ``tip_over_margin(p, theta1) >= margin`` for every |theta2| up to the limit.
@@ -34,6 +36,7 @@ def tip_safe_swivel_limit(p: SwivelCarParams, swivel_limit: float, margin: float
     ------
     ValueError
         Bad arguments, or not even theta2 = 0 satisfies the rule.
+
     """
     if not (math.isfinite(swivel_limit) and 0.0 < swivel_limit <= p.max_swivel_angle):
         raise ValueError(f'swivel_limit must be in (0, {p.max_swivel_angle!r}], '
@@ -52,14 +55,18 @@ def tip_safe_swivel_limit(p: SwivelCarParams, swivel_limit: float, margin: float
 
 
 def swivel_is_tip_safe(model: planar.TabulatedModel, theta2: float, margin: float) -> bool:
-    """Whether eq. 72 holds with ``margin`` at swivel angle theta2, by the tabulated lift
-    angle. # theta2 [rad], margin [rad]"""
+    """
+    Tell whether eq. 72 holds with ``margin`` [rad] at swivel angle theta2 [rad].
+
+    By the tabulated lift angle.
+    """
     return kinematics.tip_over_margin(model.p, model.lift_angle(theta2)) >= margin
 
 
 @dataclass(frozen=True)
 class SteeringCommand:
-    """A velocity command resolved for the swivel car.
+    """
+    A velocity command resolved for the swivel car.
 
     ``swivel`` is None when the command is a standstill: the swivel then holds where it is.
     ``tightest`` marks a command beyond the reachable curvature (turn on the spot): its speed
@@ -73,7 +80,8 @@ class SteeringCommand:
 
 
 class SteeringMap:
-    """Maps (v, omega) to a swivel angle and a forward speed.
+    """
+    Maps (v, omega) to a swivel angle and a forward speed.
 
     The swivel angle comes from the parameters' tabulated model (``model``,
     ``swivel_car_model.planar.TabulatedModel``), within 1e-7 rad of the exact inverse.
@@ -85,6 +93,7 @@ class SteeringMap:
         Largest |theta2| steering may use (already tip-safe). # [rad]
     max_speed : float
         Largest |v|. # [m/s]
+
     """
 
     def __init__(self, p: SwivelCarParams, swivel_limit: float, max_speed: float) -> None:
@@ -97,7 +106,7 @@ class SteeringMap:
         self.model = planar.tabulated_model(p)
 
     def resolve(self, v: float, omega: float) -> SteeringCommand:
-        """The swivel angle and speed for a wanted (v [m/s], omega [rad/s])."""
+        """Return the swivel angle and speed for a wanted (v [m/s], omega [rad/s])."""
         if not (math.isfinite(v) and math.isfinite(omega)):
             raise ValueError(f'v and omega must be finite, got {v!r}, {omega!r}')
         if v == 0.0 and omega == 0.0:
