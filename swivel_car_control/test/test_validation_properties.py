@@ -122,11 +122,32 @@ def test_a_pid_step_with_a_bad_input_is_refused_and_keeps_its_memory(slot, bad):
 
 
 @given(name=st.sampled_from(['max_value', 'max_rate']),
-       bad=st.just(math.nan) | at_most(0.0))
+       bad=st.just(math.nan) | at_most(0.0) | NOT_NUMERIC | st.booleans())
 def test_slew_limiter_refuses_a_bad_limit_naming_it(name, bad):
     with pytest.raises(ValueError) as error:
         SlewLimiter(**{'max_value': 1.0, 'max_rate': 1.0, name: bad})
     assert_refusal_names(error.value, name)
+
+
+# max_rate=None is no override.
+@given(bad=st.just(math.nan) | at_most(-1e-9) | st.sampled_from(['1.0', [1.0]]) | st.booleans(),
+       target=st.floats(-2.0, 2.0))
+def test_a_slew_limiter_step_with_a_bad_rate_override_is_refused_and_keeps_its_value(
+        bad, target):
+    limiter = SlewLimiter(1.0, 1.0, initial=0.25)
+    with pytest.raises(ValueError) as error:
+        limiter.step(target, 0.1, max_rate=bad)
+    assert_refusal_names(error.value, 'max_rate')
+    assert limiter.value == 0.25
+
+
+@given(bad=NOT_A_FINITE_NUMBER | st.booleans())
+def test_a_slew_limiter_refuses_a_bad_target_naming_it(bad):
+    limiter = SlewLimiter(1.0, 1.0, initial=0.25)
+    with pytest.raises(ValueError) as error:
+        limiter.step(bad, 0.1)
+    assert_refusal_names(error.value, 'target')
+    assert limiter.value == 0.25
 
 
 @given(bad=NON_FINITE | at_most(-1e-9), target=st.floats(-2.0, 2.0))

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+from swivel_car_model.checks import check_finite_number
+
 
 class SlewLimiter:
     """
@@ -21,21 +23,19 @@ class SlewLimiter:
     """
 
     def __init__(self, max_value: float, max_rate: float, initial: float = 0.0) -> None:
-        for name, value in (('max_value', max_value), ('max_rate', max_rate)):
-            if math.isnan(value) or value <= 0.0:
-                raise ValueError(f'{name} must be > 0, got {value!r}')
+        _check_rate('max_value', max_value, above_zero=True)
+        _check_rate('max_rate', max_rate, above_zero=True)
         self.max_value = max_value
         self.max_rate = max_rate
-        self.value = self._clamp(initial)
+        self.value = self._clamp('initial', initial)
 
-    def _clamp(self, value: float) -> float:
-        if not math.isfinite(value):
-            raise ValueError(f'value must be finite, got {value!r}')
+    def _clamp(self, name: str, value: float) -> float:
+        check_finite_number(name, value)
         return max(-self.max_value, min(self.max_value, value))
 
     def reset(self, value: float) -> None:
         """Jump to ``value`` (clamped), e.g. to the measured state."""
-        self.value = self._clamp(value)
+        self.value = self._clamp('value', value)
 
     def step(self, target: float, dt: float, max_rate: float | None = None) -> float:
         """
@@ -43,13 +43,24 @@ class SlewLimiter:
 
         ``max_rate`` overrides the configured rate for this step (e.g. a planner's move rate).
         """
-        target = self._clamp(target)
-        if not math.isfinite(dt) or dt < 0.0:
-            raise ValueError(f'dt must be finite and >= 0, got {dt!r}')
+        target = self._clamp('target', target)
+        check_finite_number('dt', dt)
+        if dt < 0.0:
+            raise ValueError(f'dt must be >= 0, got {dt!r}')
+        if max_rate is not None:
+            _check_rate('max_rate', max_rate, above_zero=False)
         rate = self.max_rate if max_rate is None else min(max_rate, self.max_rate)
         step = rate * dt if dt > 0.0 else 0.0
         self.value += max(-step, min(step, target - self.value))
         return self.value
+
+
+def _check_rate(name: str, value: float, above_zero: bool) -> None:
+    """Refuse anything but a number > 0 (``above_zero``) or >= 0; inf is allowed."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value) \
+            or value < 0.0 or (above_zero and value == 0.0):
+        bound = '> 0' if above_zero else '>= 0'
+        raise ValueError(f'{name} must be a number {bound}, got {value!r}')
 
 
 def steering_speed_scale(error: float, full_below: float, stop_above: float) -> float:
