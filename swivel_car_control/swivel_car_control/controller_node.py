@@ -60,6 +60,12 @@ class ControllerNode(Node):
             'use_stamped', True, ParameterDescriptor(
                 description='cmd_vel is geometry_msgs/TwistStamped (true) or Twist',
                 read_only=True)).value
+        self._base_frame_id = self.declare_parameter(
+            'base_frame_id', 'base_link',
+            ParameterDescriptor(description='frame of ~/cmd_vel_out (REP-105 base_link)',
+                                read_only=True)).value
+        if not self._base_frame_id:
+            raise ValueError('base_frame_id must be a non-empty string')
         swivel_joint = self.declare_parameter(
             'swivel_joint', 'swivel_joint',
             ParameterDescriptor(description='name of the swivel joint in joint_states',
@@ -268,7 +274,7 @@ class ControllerNode(Node):
 
         limited = TwistStamped()
         limited.header.stamp = msg.header.stamp
-        limited.header.frame_id = 'base_link'
+        limited.header.frame_id = self._base_frame_id
         limited.twist.linear.x = out.v_out
         limited.twist.angular.z = out.omega_out
         self._cmd_out_pub.publish(limited)

@@ -400,3 +400,19 @@ def test_odometry_publishes_at_its_rate_by_joint_states_time():
         assert all(b - a in (20, 30) for a, b in zip(stamps, stamps[1:])), str(stamps)
     finally:
         harness.close()
+
+
+def test_cmd_vel_out_is_in_the_base_frame_id():
+    harness = Harness(ControllerNode, {'base_frame_id': 'robot1/base_link'})
+    try:
+        out = harness.record(TwistStamped, 'controller/cmd_vel_out')
+        harness.joints = harness.probe.create_publisher(JointState, 'joint_states', 10)
+        harness.cmd_vel = harness.probe.create_publisher(TwistStamped, 'cmd_vel', 10)
+        harness.wait_connected(harness.joints)
+        harness.wait_connected(harness.cmd_vel)
+        send_cmd_vel(harness, 0.2, 0.0, 1.0)
+        harness.joints.publish(joint_state(1.0))
+        spin_until(harness.executor, lambda: out, 10.0, 'cmd_vel_out')
+        assert out[-1].header.frame_id == 'robot1/base_link'
+    finally:
+        harness.close()

@@ -42,6 +42,8 @@ PARAMETERS: dict[str, tuple[object, str]] = {
     'ground_friction': (1.0, '[1] friction coefficient of the ground'),
     'body_collision': (False, 'give the body collision shapes too, not only the wheels (a '
                               'phi < 0 robot, whose belly meets step edges)'),
+    'world_frame_id': ('world', 'fixed frame of ground_truth/odom and ~/reset_event'),
+    'base_frame_id': ('base_link', 'frame of the robot body: imu, ground_truth/odom child'),
     **description.PARAMETERS,
 }
 
@@ -67,6 +69,8 @@ class SimNodeConfig:
     start_paused: bool
     imu_every: int  # [1]
     ground_truth_every: int  # [1]
+    world_frame_id: str
+    base_frame_id: str
 
     @classmethod
     def from_values(cls, values: dict[str, object]) -> 'SimNodeConfig':
@@ -90,6 +94,9 @@ class SimNodeConfig:
                 v[name] = float(value)
             elif not isinstance(value, str):
                 raise ValueError(f'{name} must be a string, got {value!r}')
+        for name in ('world_frame_id', 'base_frame_id'):
+            if not v[name]:
+                raise ValueError(f'{name} must be a non-empty string')
         robot = description.CarDescription.from_values(
             {name: v[name] for name in description.PARAMETERS})
         physics = SimConfig(
@@ -117,7 +124,8 @@ class SimNodeConfig:
                    lockstep_real_time_factor=v['lockstep_real_time_factor'],
                    initial_pose=(v['initial_x'], v['initial_y'], v['initial_yaw']),
                    start_paused=v['start_paused'], imu_every=every['imu_rate'],
-                   ground_truth_every=every['ground_truth_rate'])
+                   ground_truth_every=every['ground_truth_rate'],
+                   world_frame_id=v['world_frame_id'], base_frame_id=v['base_frame_id'])
 
 
 def _whole_ratio(numerator: float, denominator: float, name: str, of: str) -> int:

@@ -24,21 +24,22 @@ def sim_time_msg(steps: int, time_step_ns: int) -> Time:
 class StateMessages:
     """One /clock, joint_states, imu and ground_truth/odom message, refilled from states."""
 
-    def __init__(self, joint_names: tuple[str, ...]) -> None:
+    def __init__(self, joint_names: tuple[str, ...], world_frame_id: str = 'world',
+                 base_frame_id: str = 'base_link') -> None:
         self.clock = Clock()
         self.joint_state = JointState()
         self.joint_state.name = list(joint_names)
         self.imu = Imu()
-        self.imu.header.frame_id = 'base_link'
+        self.imu.header.frame_id = base_frame_id
         self.odometry = Odometry()
-        self.odometry.header.frame_id = 'world'
-        self.odometry.child_frame_id = 'base_link'
+        self.odometry.header.frame_id = world_frame_id
+        self.odometry.child_frame_id = base_frame_id
 
     def fill(self, state: RobotState, stamp: Time, imu: bool, odometry: bool) -> None:
         """
         Refill the messages (imu and odometry only when asked) with ``state`` at ``stamp``.
 
-        Ground truth: pose of base_link in ``world``, twist in base_link (child frame).
+        Ground truth: pose of the base frame in the world frame, twist in the base frame.
         """
         self.clock.clock = stamp
         js = self.joint_state

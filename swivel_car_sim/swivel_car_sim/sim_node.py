@@ -57,7 +57,8 @@ class SimNode(Node):
         self._periods = 0
         self._period_start_wall = self._last_publish_wall = time.monotonic()
         self._next_due_wall = self._period_start_wall  # [s] steady clock of the next paced advance
-        self._messages = StateMessages(self.sim.joint_names)
+        self._messages = StateMessages(self.sim.joint_names, cfg.world_frame_id,
+                                       cfg.base_frame_id)
         self._reset_ns = 0  # [ns] sim time of the first state after the last ~/reset
 
         self._clock_pub = self.create_publisher(ClockMsg, '/clock', 10)
@@ -249,7 +250,7 @@ class SimNode(Node):
         self._periods += 1
         self._command_ready = False
         self._reset_ns = self.sim.steps * self._time_step_ns
-        self._reset_pub.publish(Header(stamp=self._stamp(), frame_id='world'))
+        self._reset_pub.publish(Header(stamp=self._stamp(), frame_id=self.config.world_frame_id))
         self._period_start_wall = time.monotonic()
         self._publish_state()
         return response

@@ -39,6 +39,8 @@ def test_rates_and_geometry_overrides():
     ({'control_period': 0.005 + 0.001}, 'control_period'),
     ({'control_period': 0.001}, 'control_period'),
     ({'control_period': 1e306}, 'control_period'),
+    ({'world_frame_id': ''}, 'world_frame_id'),
+    ({'base_frame_id': 3}, 'base_frame_id'),
     ({'imu_rate': 0.0}, 'imu_rate'),
     ({'ground_truth_rate': 70.0}, 'ground_truth_rate'),
     ({'lockstep_timeout': -1.0}, 'lockstep_timeout'),

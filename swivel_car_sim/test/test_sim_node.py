@@ -314,3 +314,11 @@ def test_bad_parameters_are_refused_at_start(name, value, message):
             SimNode(context=context, parameter_overrides=[Parameter(name, value=value)])
     finally:
         rclpy.try_shutdown(context=context)
+
+
+def test_frame_ids_are_parameters(harness_factory):
+    h = harness_factory(lockstep=False, world_frame_id='map', base_frame_id='robot1/base_link')
+    spin_until(h.executor, lambda: h.odom and h.imu, TIMEOUT, 'ground truth and imu')
+    assert (h.odom[-1].header.frame_id, h.odom[-1].child_frame_id) == ('map',
+                                                                       'robot1/base_link')
+    assert h.imu[-1].header.frame_id == 'robot1/base_link'
