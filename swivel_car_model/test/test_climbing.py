@@ -30,8 +30,8 @@ def rim_points(centre, axle, r, n=20000):
 def test_extreme_points_match_rim_sampling(p):
     for theta2 in ANGLES:
         frames = k.forward_kinematics(p, theta2)
-        steering, lifted = (frames.o3, frames.o3_left) if theta2 >= 0 else (frames.o3_left,
-                                                                              frames.o3)
+        steering, lifted = ((frames.o3, frames.o3_left) if theta2 >= 0
+                            else (frames.o3_left, frames.o3))
         lifted_rim = rim_points(lifted[:3, 3], lifted[:3, 2], p.r)
         steering_rim = rim_points(steering[:3, 3], steering[:3, 2], p.r)
         low = lifted_rim[np.argmin(lifted_rim[:, 2])]
