@@ -1,4 +1,5 @@
-"""Whole-car climbing benchmark in physics: ``python -m swivel_car_bringup.climb_benchmark``.
+"""
+Whole-car climbing benchmark in physics: ``python -m swivel_car_bringup.climb_benchmark``.
 
 Climbs steps from 2 to 20 cm in 1 cm increments, each from randomised requests (distance from
 the front axle to the edge, the edge's yaw, the top face's width and where along the edge it
@@ -34,15 +35,13 @@ import time
 
 from ament_index_python.packages import get_package_share_directory
 import numpy as np
-import yaml
-
+from swivel_car_bringup.inprocess import InProcessStack, StackConfig
 from swivel_car_model import kinematics, traction
 from swivel_car_model.checks import check_finite_number
 from swivel_car_model.description import CarDescription
 from swivel_car_planner.core import ClimbRequest, ErrorCode
 from swivel_car_planner.core.capability import CapabilityTable, description_values, RELIABLE
-
-from swivel_car_bringup.inprocess import InProcessStack, StackConfig
+import yaml
 
 _NOT_ATTEMPTED = (ErrorCode.INVALID_REQUEST,)
 _REFUSED = (ErrorCode.UNREACHABLE_HEIGHT, ErrorCode.TIP_OVER, ErrorCode.TORQUE_LIMIT,
@@ -79,13 +78,15 @@ class Trial:
 
 @dataclass(frozen=True)
 class RequestRanges:
-    """Where randomised climb requests are drawn from (uniformly).
+    """
+    Where randomised climb requests are drawn from (uniformly).
 
     Raises
     ------
     ValueError
         A bound that is not a finite number, a minimum above its maximum, or no width (the
         sim's step needs a top face); the message names it.
+
     """
 
     min_distance: float = 0.2  # [m] front axle to the edge
@@ -107,14 +108,14 @@ class RequestRanges:
                                  f'{getattr(self, high)!r}')
 
     def draw(self, rng: random.Random) -> tuple[float, float, float, float]:
-        """distance [m], yaw [rad], width [m], offset [m] of one request."""
+        """Draw the distance [m], yaw [rad], width [m] and offset [m] of one request."""
         return (rng.uniform(self.min_distance, self.max_distance),
                 rng.uniform(-self.max_yaw, self.max_yaw),
                 rng.uniform(self.min_width, self.max_width),
                 rng.uniform(-self.max_offset, self.max_offset))
 
     def bounds(self) -> tuple[tuple[float, float, float, float], ...]:
-        """The lowest and the highest (distance, yaw, width, offset) ``draw`` returns."""
+        """Return the lowest and the highest (distance, yaw, width, offset) ``draw`` returns."""
         return ((self.min_distance, -self.max_yaw, self.min_width, -self.max_offset),
                 (self.max_distance, self.max_yaw, self.max_width, self.max_offset))
 
@@ -132,16 +133,27 @@ def sign_changes(torque: np.ndarray, threshold: float = _CHATTER_TORQUE) -> int:
 
 def climb_trial(stack: InProcessStack, height: float, distance: float, yaw: float,
                 width: float, offset: float) -> Trial:
-    """One climb from where ``stack`` stands: the car settles, a step appears ahead, the
-    planner climbs it, the car rests a second, and the ground truth judges it.
+    """
+    Run one climb from where ``stack`` stands.
+
+    The car settles, a step appears ahead, the planner climbs it, the car rests a second, and
+    the ground truth judges it.
 
     Parameters
     ----------
-    height : float  # [m]
-    distance : float  # [m] front axle to the edge
-    yaw : float  # [rad] the edge's
-    width : float  # [m] the top face along the edge
-    offset : float  # [m] the face centre along the edge
+    stack : InProcessStack
+        The running stack the climb drives.
+    height : float
+        Step height. # [m]
+    distance : float
+        Front axle to the edge. # [m]
+    yaw : float
+        The edge's yaw. # [rad]
+    width : float
+        The top face along the edge. # [m]
+    offset : float
+        The face centre along the edge. # [m]
+
     """
     stack.settle(0.2)
     stack.spawn_step(height, distance, yaw, width=width, depth=3.0)
@@ -187,8 +199,11 @@ def run_swivel(args: argparse.Namespace, config: StackConfig, ranges: RequestRan
 
 
 def run_car_like(args: argparse.Namespace, robot: dict) -> dict[float, bool]:
-    """Drive the car-like baseline straight at each step; True where all four wheels end on
-    top. Stops after two heights in a row fail (higher ones only fail the more)."""
+    """
+    Drive the car-like baseline straight at each step; True where all four wheels end on top.
+
+    Stops after two heights in a row fail (higher ones only fail the more).
+    """
     results: dict[float, bool] = {}
     with InProcessStack('car_like', robot=robot) as stack:
         for height in _heights(args):
@@ -283,8 +298,11 @@ def report(trials: list[Trial], car_like: dict[float, bool],
 
 
 def design_values(path: str | Path) -> dict:
-    """The robot description parameters of a design file (``config/designs/*.yaml``, a
-    params file for every node: ``/**: ros__parameters``)."""
+    """
+    Read the robot description parameters of a design file (``config/designs/*.yaml``).
+
+    A design file is a params file for every node: ``/**: ros__parameters``.
+    """
     return dict(yaml.safe_load(Path(path).read_text())['/**']['ros__parameters'])
 
 
@@ -343,7 +361,7 @@ def main(argv: list[str] | None = None) -> None:
                         type=lambda text: [float(v) for v in text.split(',') if v],
                         metavar='H1,H2,...',
                         help="[m] then the phi < 0 design's table (semi-active procedure, "
-                             "config/designs/phi_negative.yaml, body colliding) at these "
+                             'config/designs/phi_negative.yaml, body colliding) at these '
                              "heights; '' skips it")
     parser.add_argument('--write-capability', type=Path, metavar='PATH',
                         help='write the whole-car capability table the planner ships')

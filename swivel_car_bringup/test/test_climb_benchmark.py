@@ -5,11 +5,9 @@ from pathlib import Path
 from ament_index_python.packages import get_package_share_directory
 import numpy as np
 import pytest
-
+from swivel_car_bringup.climb_benchmark import design_values, heights, main, sign_changes
 from swivel_car_model.description import CarDescription
 from swivel_car_planner.core.capability import CapabilityTable
-
-from swivel_car_bringup.climb_benchmark import design_values, heights, main, sign_changes
 
 
 def test_sign_changes_ignore_the_band_around_zero():

@@ -1,5 +1,7 @@
-"""Step-climbing geometry (thesis chapter III): approach for phi > 0, assisting torque and
-minimum approach angle for phi < 0.
+"""
+Step-climbing geometry (thesis chapter III).
+
+The approach for phi > 0, the assisting torque and minimum approach angle for phi < 0.
 
 All positions are in the level base_link frame of :mod:`swivel_car_model.kinematics` (same sign
 conventions: ``theta2 > 0`` lifts the **left** front wheel, the right one steers). Corrections
@@ -21,8 +23,8 @@ to the thesis (listed in docs/thesis_reproduction.md):
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 
 import numpy as np
 
@@ -58,14 +60,14 @@ def _front_wheels(p: SwivelCarParams, theta2: np.ndarray):
 
 
 def lifted_wheel_lowest_point(p: SwivelCarParams, theta2: ArrayLike) -> np.ndarray:
-    """Lowest rim point ``P_L`` of the lifted wheel, ``(..., 3)`` in level base_link. # [m]"""
+    """Return the lifted wheel's lowest rim point ``P_L``, (..., 3), in level base_link [m]."""
     t2 = np.asarray(theta2, dtype=float)
     _, lifted, axle = _front_wheels(p, t2)
     return _rim_extreme(lifted, axle, np.array([0.0, 0.0, -1.0]), p.r)
 
 
 def steering_wheel_front_point(p: SwivelCarParams, theta2: ArrayLike) -> np.ndarray:
-    """Foremost rim point ``C_F`` of the steering wheel, ``(..., 3)`` in level base_link. # [m]"""
+    """Return the steering wheel's foremost rim point ``C_F``, (..., 3), in level base_link [m]."""
     t2 = np.asarray(theta2, dtype=float)
     steering, _, axle = _front_wheels(p, t2)
     return _rim_extreme(steering, axle, np.array([1.0, 0.0, 0.0]), p.r)
@@ -76,7 +78,8 @@ def steering_wheel_front_point(p: SwivelCarParams, theta2: ArrayLike) -> np.ndar
 
 @dataclass(frozen=True)
 class ApproachPlan:
-    """How to approach a step so that the lifted wheel lands on its edge at heading ``gamma``.
+    """
+    How to approach a step so that the lifted wheel lands on its edge at heading ``gamma``.
 
     The robot starts at base_link = origin with heading ``theta_i`` to the step normal (the
     step face is the line ``X = distance`` of a world frame whose X axis is the normal), turns
@@ -94,7 +97,8 @@ class ApproachPlan:
 
 def approach_for_step(p: SwivelCarParams, step_height: float, gamma: float, theta_i: float,
                       include_drift: bool = True) -> ApproachPlan:
-    """Approach distance for a step at incidence ``theta_i`` ending at heading ``gamma``.
+    """
+    Approach distance for a step at incidence ``theta_i`` ending at heading ``gamma``.
 
     Headings are measured from the step normal, positive counter-clockwise. The turn
     ``gamma - theta_i`` picks the swivel sign: the swivel angle of
@@ -105,6 +109,7 @@ def approach_for_step(p: SwivelCarParams, step_height: float, gamma: float, thet
     ------
     ValueError
         NaN, a step out of reach, or a turn of zero / more than a half turn.
+
     """
     for name, value in (('step_height', step_height), ('gamma', gamma), ('theta_i', theta_i)):
         _finite(name, value)
@@ -144,7 +149,8 @@ def approach_for_step(p: SwivelCarParams, step_height: float, gamma: float, thet
 
 def induced_swivel_torque(p: SwivelCarParams, drive_torque: ArrayLike,
                           theta2: ArrayLike = 0.0) -> ArrayLike:
-    """Swivel torque induced by the step pushing back on the wheel that is to be lifted.
+    """
+    Swivel torque induced by the step pushing back on the wheel that is to be lifted.
 
     The wheel's drive torque ``tau_D`` pushes it against the step edge with ``F = tau_D / r``;
     the reaction ``-F`` (horizontal, backwards, applied at the wheel centre) has a moment about
@@ -152,6 +158,8 @@ def induced_swivel_torque(p: SwivelCarParams, drive_torque: ArrayLike,
 
     Parameters
     ----------
+    p : SwivelCarParams
+        The car's model parameters.
     drive_torque : float or array
         Drive torque at the wheel touching the step, >= 0. # [N m]
     theta2 : float or array
@@ -162,6 +170,7 @@ def induced_swivel_torque(p: SwivelCarParams, drive_torque: ArrayLike,
     float or array
         Assisting torque: positive helps lift the wheel at the step (phi < 0), negative
         pushes it down (phi > 0). # [N m]
+
     """
     tau = _finite('drive_torque', drive_torque)
     if np.any(tau < 0.0):
@@ -186,7 +195,8 @@ def induced_swivel_torque(p: SwivelCarParams, drive_torque: ArrayLike,
 # phi < 0: minimum approach angle (eqs. 92-100)
 
 def min_approach_angle(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLike:
-    """Angle between the step face and the ground line through ``P_L`` and ``C_F`` (eq. 100).
+    """
+    Angle between the step face and the ground line through ``P_L`` and ``C_F`` (eq. 100).
 
     Approaching the step face at less than this angle lets the steering wheel's front ``C_F``
     reach the face before the lifted wheel's lowest point ``P_L`` is over the edge.
@@ -195,6 +205,7 @@ def min_approach_angle(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLike:
     -------
     float or array
         In ``[0, pi/2]``. # [rad]
+
     """
     t2 = kinematics._check_swivel(p, theta2)
     line = (steering_wheel_front_point(p, t2) - lifted_wheel_lowest_point(p, t2))[..., :2]
@@ -203,5 +214,5 @@ def min_approach_angle(p: SwivelCarParams, theta2: ArrayLike) -> ArrayLike:
 
 
 def min_approach_angle_for_step(p: SwivelCarParams, step_height: ArrayLike) -> ArrayLike:
-    """:func:`min_approach_angle` at the smallest swivel angle that clears the step. # [rad]"""
+    """Return :func:`min_approach_angle` at the smallest swivel angle clearing the step [rad]."""
     return min_approach_angle(p, kinematics.swivel_for_step(p, step_height))

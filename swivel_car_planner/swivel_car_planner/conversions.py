@@ -8,7 +8,7 @@ from swivel_car_planner.core import ClimbPlan, ClimbRequest, Outcome
 
 
 def request_from(message, with_time_allowance: bool) -> ClimbRequest:
-    """A core request from a srv/ClimbStep request or an action/ClimbStep goal."""
+    """Make a core request from a srv/ClimbStep request or an action/ClimbStep goal."""
     return ClimbRequest(
         step_height=float(message.step_height), step_distance=float(message.step_distance),
         step_yaw=float(message.step_yaw), plan_only=bool(message.plan_only),
@@ -31,4 +31,3 @@ def outcome_to_msg(outcome: Outcome) -> ClimbOutcome:
         duration=float(outcome.duration), peak_torque=float(outcome.peak_torque),
         energy=float(outcome.energy), max_pitch=float(outcome.max_pitch),
         distance_travelled=float(outcome.distance_travelled))
-

@@ -1,6 +1,9 @@
-"""Judging a climb by the sim's ground truth, ROS-free: shared by the system tests (from
-``ground_truth/odom``) and the in-process stack (``swivel_car_bringup.inprocess``, from the sim
-core's state)."""
+"""
+Judging a climb by the sim's ground truth, ROS-free.
+
+Shared by the system tests (from ``ground_truth/odom``) and the in-process stack
+(``swivel_car_bringup.inprocess``, from the sim core's state).
+"""
 
 from __future__ import annotations
 
@@ -26,8 +29,12 @@ class GroundTruth:
     @classmethod
     def from_pose(cls, position: Sequence[float], orientation: Sequence[float],
                   velocity: Sequence[float]) -> GroundTruth:
-        """From base_link's position [m], orientation quaternion (x, y, z, w) and linear
-        velocity [m/s] (any frame: only its norm is kept)."""
+        """
+        Make the ground truth from base_link's position, orientation and linear velocity.
+
+        Position [m], orientation quaternion (x, y, z, w), linear velocity [m/s] (any frame:
+        only its norm is kept).
+        """
         roll, pitch = roll_pitch(*orientation)
         vx, vy, vz = velocity
         return cls(float(position[0]), float(position[1]), float(position[2]), roll, pitch,
@@ -41,14 +48,21 @@ class GroundTruth:
 
     def four_wheels_on_top(self, height: float, wheel_radius: float,
                            tolerance: float = 0.01) -> bool:
-        """The rear axle (base_link) at step height and the car level: with the rear wheels
-        up, the front ones, a wheelbase ahead, are too. height, wheel_radius, tolerance [m]"""
+        """
+        Tell whether the rear axle (base_link) is at step height and the car level.
+
+        With the rear wheels up, the front ones, a wheelbase ahead, are too. height,
+        wheel_radius, tolerance [m]
+        """
         return (abs(self.z - (height + wheel_radius)) < tolerance
                 and abs(self.pitch) < 0.05 and abs(self.roll) < 0.05)
 
     def front_on_top(self, height: float, wheel_radius: float, wheelbase: float,
                      tolerance: float = 0.015) -> bool:
-        """The front axle (``wheelbase`` ahead of base_link) at step height. height,
-        wheel_radius, wheelbase, tolerance [m]"""
+        """
+        Tell whether the front axle (``wheelbase`` ahead of base_link) is at step height.
+
+        height, wheel_radius, wheelbase, tolerance [m]
+        """
         front = self.z - wheelbase * math.sin(self.pitch)
         return front > height + wheel_radius - tolerance

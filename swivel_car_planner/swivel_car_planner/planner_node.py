@@ -1,4 +1,5 @@
-"""The planner node: climb_step as a service and as an action, one shared climb.
+"""
+The planner node: climb_step as a service and as an action, one shared climb.
 
 The core's ``ClimbStateMachine`` steps once per controller state, on the inputs of that
 moment (``core.sync``), and the command it answers carries that moment's stamp: in a lockstep
@@ -11,13 +12,13 @@ busy-wait at full CPU while a climb ran.)
 
 from __future__ import annotations
 
+from dataclasses import dataclass, fields, replace
 import math
 import sys
 import time
-from dataclasses import dataclass, fields, replace
 
 from nav_msgs.msg import Odometry
-from rclpy.time import Time
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.action.server import ServerGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -25,20 +26,18 @@ from rclpy.clock import Clock, ClockType
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.task import Future
-from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rclpy.time import Time
 from sensor_msgs.msg import Imu, JointState
 from swivel_car_model import dynamics, kinematics
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
-from swivel_car_ros.ros_params import declare_description, run_node
-
 from swivel_car_planner.conversions import outcome_to_msg, plan_to_msg, request_from
 from swivel_car_planner.core import (
-    ClimbRequest, ClimbStateMachine, Command, ErrorCode, PlanError,
-    PlannerConfig, make_plan, validate_request)
-from swivel_car_planner.core import capability, inputs
+    capability, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs, make_plan,
+    PlanError, PlannerConfig, validate_request)
 from swivel_car_planner.core.sync import InputSync, Tick
+from swivel_car_ros.ros_params import declare_description, run_node
 
 _CONTROLLER_STATE = inputs.CONTROLLER_STATE
 _INPUTS = inputs.INPUTS
@@ -142,7 +141,7 @@ class PlannerNode(Node):
         return value
 
     def _changed_config(self, parameters: list) -> PlannerConfig:
-        """The climb settings with ``parameters`` set. Raises ValueError naming a bad one."""
+        """Return the climb settings with ``parameters`` set; ValueError names a bad one."""
         names = {item.name for item in fields(PlannerConfig)}
         return replace(self.config, **{p.name: p.value for p in parameters if p.name in names})
 
@@ -160,13 +159,16 @@ class PlannerNode(Node):
             self.get_logger().info('climb settings changed: they apply from the next climb')
 
     def _load_capability(self, value: str) -> float:
-        """The highest step the whole car climbs reliably, from the table ``value`` names
-        (``capability.table_for``). # [m]
+        """
+        Return the highest step the whole car climbs reliably [m].
+
+        From the table ``value`` names (``capability.table_for``).
 
         Raises
         ------
         ValueError
             The file cannot be read as a table.
+
         """
         table, path = capability.table_for(value)
         if table is None:
@@ -208,7 +210,7 @@ class PlannerNode(Node):
 
     def _on_controller_state(self, msg: SwivelControllerState) -> None:
         self._add(_CONTROLLER_STATE, msg, inputs.controller_state_values(msg.set_point,
-                                                                          msg.torque))
+                                                                         msg.torque))
 
     def _add(self, topic: str, msg, value: tuple) -> None:
         self._received[topic] = self._now()
@@ -217,7 +219,7 @@ class PlannerNode(Node):
             self._on_tick(tick)
 
     def _missing_inputs(self) -> list[str]:
-        """Inputs not heard within ``ready_timeout`` of sim time (all, before /clock)."""
+        """List the inputs not heard within ``ready_timeout`` of sim time (all, before /clock)."""
         now = self._now()
         return [topic for topic in _INPUTS
                 if now <= 0.0 or topic not in self._received
@@ -307,11 +309,13 @@ class PlannerNode(Node):
             self._end(climb, tick.time)
 
     def _check_inputs_alive(self) -> None:
-        """A climb whose inputs stopped (odometry or controller gone) ends: the controller's
-        swivel_command deadman has stopped the car by then.
+        """
+        End a climb whose inputs stopped (odometry or controller gone).
 
+        The controller's swivel_command deadman has stopped the car by then.
         Only after two checks in a row without a tick: after the executor was held up (a long
-        plan), this timer runs before the queued inputs and would see a stale tick."""
+        plan), this timer runs before the queued inputs and would see a stale tick.
+        """
         climb = self._climb
         if climb is None:
             return
@@ -325,8 +329,12 @@ class PlannerNode(Node):
                     f'{now:.2f} s; missing: {missing}; {self._sync.describe()}')
 
     def _check_sim_alive(self) -> None:
-        """A climb whose sim died (or was paused) ends after ``ready_timeout`` of wall time
-        without a tick: sim time stands still then, so the sim-time check never fires."""
+        """
+        End a climb whose sim died (or was paused) after ``ready_timeout`` of wall time.
+
+        That is, without a tick: sim time stands still then, so the sim-time check never
+        fires.
+        """
         climb = self._climb
         if climb is None:
             return
@@ -347,8 +355,11 @@ class PlannerNode(Node):
         self._end(climb, stamp)
 
     def _end(self, climb: _ActiveClimb, stamp: float) -> None:
-        """After a failure the swivel holds where it is (the last command) and is released:
-        the controller keeps holding it, and cmd_vel steers again."""
+        """
+        End the climb; after a failure the swivel holds where it is and is released.
+
+        The last command holds it; the controller keeps holding it, and cmd_vel steers again.
+        """
         self._climb = None
         for command in inputs.end_commands(climb.machine.outcome):
             self._publish_command(command, stamp)

@@ -92,8 +92,8 @@ def test_step_above_the_measured_whole_car_limit_is_refused_with_the_limit():
 
 def test_plan_only_makes_exactly_the_checks_of_a_real_call():
     no_backup = dataclasses.replace(CONFIG, max_backup=0.0)
-    for kwargs in (dict(height=WHOLE_CAR_LIMIT + 0.01), dict(distance=0.1, config=no_backup),
-                   dict(width=0.3)):
+    for kwargs in ({'height': WHOLE_CAR_LIMIT + 0.01}, {'distance': 0.1, 'config': no_backup},
+                   {'width': 0.3}):
         real = refusal(whole_car_limit=WHOLE_CAR_LIMIT, **kwargs)
         planned = refusal(whole_car_limit=WHOLE_CAR_LIMIT, plan_only=True, **kwargs)
         assert (planned.code, planned.message) == (real.code, real.message)
@@ -111,9 +111,12 @@ def test_approach_accounts_for_the_drift_of_the_lift():
 
 
 def drive_arc(plan, steps=2000):
-    """Euler-integrate base_link along the plan's advance from its heading once the wheel is
-    up, at the model's curvature; the front wheels' rest points' normal coordinates, relative
-    to the start, along the way. # [m]"""
+    """
+    Euler-integrate base_link along the plan's advance from its heading once the wheel is up.
+
+    At the model's curvature; returns the front wheels' rest points' normal coordinates,
+    relative to the start, along the way [m].
+    """
     curvature = planar.curvature_for_swivel(P, plan.swivel_angle)
     heading = plan.lead_angle - plan.advance_turn
     ds = plan.advance_length / steps
@@ -141,10 +144,14 @@ def test_the_advance_arc_takes_the_lifted_wheel_over_the_edge_clear_of_the_other
 
 
 def test_a_tight_advance_arc_is_planned_as_one():
-    """At 26 cm the swivel is held at 1.24 rad: a 0.49 m radius, and the lift alone turns the
+    """
+    Check a tight advance arc is planned as one.
+
+    At 26 cm the swivel is held at 1.24 rad: a 0.49 m radius, and the lift alone turns the
     car 0.37 rad. The arc ends more oblique than the straight-line lead angle (the other
     wheel swings towards the riser on the way) and the approach leads with the other wheel.
-    At 27 cm (1.37 rad, 0.28 m) no heading keeps the other wheel off the riser."""
+    At 27 cm (1.37 rad, 0.28 m) no heading keeps the other wheel off the riser.
+    """
     plan = make_plan(P, STANDARD, request(0.26))
     assert not plan.push_lift
     assert abs(plan.swivel_angle) <= P.swivel_limit
@@ -155,9 +162,13 @@ def test_a_tight_advance_arc_is_planned_as_one():
 
 
 def test_where_no_heading_keeps_the_other_wheel_off_the_riser_the_grounded_one_leads():
-    """The push-lift (docs/climbing_design.md, "The front wheels"): at 27 cm the approach
+    """
+    Check the grounded wheel leads where no heading keeps the other wheel off the riser.
+
+    The push-lift (docs/climbing_design.md, "The front wheels"): at 27 cm the approach
     turns the other way, the grounded wheel stops push_gap short of the riser and the lifted
-    one trails it by 2 h sin(push_lead)."""
+    one trails it by 2 h sin(push_lead).
+    """
     plan = make_plan(P, FRONT, request(0.27, distance=3.0))
     assert plan.push_lift
     assert plan.swivel_angle == pytest.approx(P.swivel_limit * plan.lifted_side)
@@ -175,7 +186,7 @@ def test_where_no_heading_keeps_the_other_wheel_off_the_riser_the_grounded_one_l
 
 
 def lowest_rim_point(centre, axle, samples=20000):
-    """Brute force: the lowest of ``samples`` points on a wheel's rim. # [m]"""
+    """Return the lowest of ``samples`` points on a wheel's rim, by brute force [m]."""
     axle = axle / np.linalg.norm(axle)
     u = np.cross(axle, [0.0, 0.0, 1.0])
     u /= np.linalg.norm(u)
@@ -202,9 +213,13 @@ def test_the_lifted_wheels_lowest_point_is_where_its_rim_is_lowest(swivel):
 
 
 def test_the_push_advance_takes_the_lifted_wheel_over_before_the_grounded_one_meets_the_riser():
-    """Euler-integrate base_link on the arc from the lift, independently of the plan's
-    closed form: the lifted wheel's lowest point ends push_margin past the edge, the
-    grounded wheel's contact never passes the riser."""
+    """
+    Check the push advance takes the lifted wheel over before the grounded one meets the riser.
+
+    Euler-integrate base_link on the arc from the lift, independently of the plan's closed
+    form: the lifted wheel's lowest point ends push_margin past the edge, the grounded wheel's
+    contact never passes the riser.
+    """
     plan = make_plan(P, FRONT, request(0.27, distance=3.0))
     curvature = planar.curvature_for_swivel(P, plan.swivel_angle)
     heading = plan.lead_angle - plan.advance_turn

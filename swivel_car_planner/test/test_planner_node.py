@@ -1,4 +1,5 @@
-"""Node tests: the real PlannerNode in-process with real rclpy, fed by a kinematic car.
+"""
+Node tests: the real PlannerNode in-process with real rclpy, fed by a kinematic car.
 
 The test plays the robot: it publishes /clock, joint_states, imu, odom and the controller
 state of ``KinematicCar`` (the model's planar kinematics) and applies the planner's
@@ -13,26 +14,25 @@ import threading
 import time
 
 from action_msgs.msg import GoalStatus
+from kinematic_car import DEFAULT_SWIVEL_RATE, DT, KinematicCar
 from nav_msgs.msg import Odometry
 import pytest
 import rclpy
-import yaml
 from rclpy.action import ActionClient
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
+from swivel_car_model import description
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
-from swivel_car_testing import next_domain_id, spin_until
-from swivel_car_model import description
-
 from swivel_car_planner.core import Command, ErrorCode, Phase, PlannerConfig
-from kinematic_car import DEFAULT_SWIVEL_RATE, DT, KinematicCar
 from swivel_car_planner.planner_node import PlannerNode
+from swivel_car_testing import next_domain_id, spin_until
+import yaml
 
-SUCCESSFUL_CLIMB = dict(step_height=0.04, step_distance=1.2, step_yaw=0.0)
+SUCCESSFUL_CLIMB = {'step_height': 0.04, 'step_distance': 1.2, 'step_yaw': 0.0}
 
 
 def test_error_codes_and_phases_match_the_interfaces():
@@ -118,7 +118,8 @@ class Rig:
             self.state.publish(msg)
 
     def drive(self, future, seconds=120.0):
-        """Close the loop until ``future`` is done: the car follows the planner's commands.
+        """
+        Close the loop until ``future`` is done: the car follows the planner's commands.
 
         Lockstep by hand: each cycle waits for the planner's command of that cycle (stamped
         with its state). Until a climb is registered there is none (a short wait, then the

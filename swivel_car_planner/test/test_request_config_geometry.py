@@ -9,7 +9,7 @@ from swivel_car_planner.core import ClimbRequest, ErrorCode, PlannerConfig, vali
 from swivel_car_planner.core.geometry import Pose2D, StepEdge, wrap_angle
 
 CONFIG = PlannerConfig()
-GOOD = dict(step_height=0.05, step_distance=1.0, step_yaw=0.1)
+GOOD = {'step_height': 0.05, 'step_distance': 1.0, 'step_yaw': 0.1}
 
 
 def test_default_config_is_valid():

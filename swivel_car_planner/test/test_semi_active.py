@@ -1,4 +1,5 @@
-"""Test the semi-active procedure (phi < 0, thesis III.B) of the climb state machine.
+"""
+Test the semi-active procedure (phi < 0, thesis III.B) of the climb state machine.
 
 On the phi < 0 design (swivel_car_model/config/designs/phi_negative.yaml) against the kinematic
 car. The physics of the riser's push is in the system test (test_system_semi_active.py).
@@ -9,12 +10,11 @@ from pathlib import Path
 from kinematic_car import KinematicCar
 import pytest
 from swivel_car_model.description import CarDescription
-import yaml
-
 from swivel_car_planner.core import (
     ClimbRequest, ClimbStateMachine, ErrorCode, make_plan, Phase, PlannerConfig)
 from swivel_car_planner.core.plan import PROCEDURE_SEMI_ACTIVE
 from swivel_car_planner.core.state_machine import Step
+import yaml
 
 DESIGN = (Path(__file__).resolve().parents[2] / 'swivel_car_model' / 'config' / 'designs'
           / 'phi_negative.yaml')

@@ -1,4 +1,5 @@
-"""Unit tests of the climb state machine against a kinematic car on flat ground.
+"""
+Unit tests of the climb state machine against a kinematic car on flat ground.
 
 ``KinematicCar`` (no step, no physics) checks the sequencing, the geometry of the phase
 changes and every monitor; the real physics is in the system tests.
@@ -7,14 +8,13 @@ changes and every monitor; the real physics is in the system tests.
 import dataclasses
 import math
 
+from kinematic_car import KinematicCar
 import pytest
 from swivel_car_model.params import SwivelCarParams
-
 from swivel_car_planner.core import (
-    ClimbRequest, ClimbStateMachine, Command, ErrorCode, Phase, PlannerConfig, make_plan)
+    ClimbRequest, ClimbStateMachine, Command, ErrorCode, make_plan, Phase, PlannerConfig)
 from swivel_car_planner.core.geometry import Pose2D, StepEdge
 from swivel_car_planner.core.state_machine import Step
-from kinematic_car import KinematicCar
 
 P = SwivelCarParams()
 CONFIG = PlannerConfig()
@@ -27,8 +27,11 @@ def start(height=0.04, distance=1.2, yaw=0.0, config=CONFIG, allowance=0.0):
 
 
 def car_before(height=0.04, distance=1.2, yaw=0.0):
-    """A car with the step of ``start``'s request placed: it pitches while only its front
-    axle is on top."""
+    """
+    Make a car with the step of ``start``'s request placed.
+
+    It pitches while only its front axle is on top.
+    """
     car = KinematicCar()
     car.place_step(height, distance, yaw)
     return car

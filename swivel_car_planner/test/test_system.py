@@ -1,15 +1,18 @@
-"""System tests: sim_node (lockstep), controller_node, odometry_node and planner_node as real
-processes; the climb is judged by the sim's ground truth."""
+"""
+System tests: the sim, controller, odometry and planner nodes as real processes.
+
+sim_node (lockstep), controller_node, odometry_node and planner_node; the climb is judged by
+the sim's ground truth.
+"""
 
 import math
 
 from action_msgs.msg import GoalStatus
 import pytest
+from sim_session import SimSession
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.srv import ClimbStep
-
 from swivel_car_planner.core import ErrorCode, Phase
-from sim_session import SimSession
 
 HEIGHT = 0.04  # [m] within the rear axle's traction limit (README: measured limits)
 DISTANCE = 1.2  # [m]

@@ -1,4 +1,5 @@
-"""System test of the semi-active climb (phi < 0, thesis III.B) through the ROS stack.
+"""
+System test of the semi-active climb (phi < 0, thesis III.B) through the ROS stack.
 
 The phi < 0 design (swivel_car_model/config/designs/phi_negative.yaml) as every node's robot
 description, the sim with the body's collision shapes (its belly hangs below the axle line),

@@ -1,8 +1,11 @@
-"""The phi < 0 design (swivel_car_model/config/designs/phi_negative.yaml) in physics: its body
-clears the ground, and the model's phi < 0 branches (lift constraint, lifted wheel, steering
-map, contact point, approach angle, turning curvature) hold for it; a driven front wheel
-pressed against a riser helps the swivel (thesis eqs. 86-91). The sim core directly,
-deterministic; docs/thesis_reproduction.md (III.B in physics) has the numbers."""
+"""
+The phi < 0 design (swivel_car_model/config/designs/phi_negative.yaml) in physics.
+
+Its body clears the ground, and the model's phi < 0 branches (lift constraint, lifted wheel,
+steering map, contact point, approach angle, turning curvature) hold for it; a driven front
+wheel pressed against a riser helps the swivel (thesis eqs. 86-91). The sim core directly,
+deterministic; docs/thesis_reproduction.md (III.B in physics) has the numbers.
+"""
 
 import math
 from pathlib import Path
@@ -33,7 +36,7 @@ def design() -> CarDescription:
 
 
 def _rim_point(sim: SwivelCarSim, joint: str, direction) -> tuple[np.ndarray, np.ndarray]:
-    """The wheel's rim point furthest along ``direction`` (world) and its axle (world)."""
+    """Return the wheel's rim point furthest along ``direction`` (world) and its axle (world)."""
     link = sim._joint_ids[sim.joint_names.index(joint)]
     state = pybullet.getLinkState(sim._body, link, computeForwardKinematics=1,
                                   physicsClientId=sim._client)
@@ -43,7 +46,7 @@ def _rim_point(sim: SwivelCarSim, joint: str, direction) -> tuple[np.ndarray, np
 
 
 def _in_level_base(state, point: np.ndarray) -> np.ndarray:
-    """A world point in the level base_link frame (x, y). # [m]"""
+    """Return a world point in the level base_link frame (x, y) [m]."""
     c, s = math.cos(state.yaw), math.sin(state.yaw)
     dx, dy = point[:2] - state.position[:2]
     return np.array([c * dx + s * dy, -s * dx + c * dy])
@@ -51,8 +54,12 @@ def _in_level_base(state, point: np.ndarray) -> np.ndarray:
 
 @pytest.fixture(scope='module')
 def swivelled(design):
-    """At rest, then the swivel held at each target in turn (theta2 > 0: the right front wheel
-    steers, the left one lifts); the smallest body clearance of every period."""
+    """
+    Hold the design at rest, then the swivel at each target in turn.
+
+    theta2 > 0: the right front wheel steers, the left one lifts. Gives the smallest body
+    clearance of every period.
+    """
     with SwivelCarSim(SimConfig(description=design, body_collision=True)) as sim:
         sim.step(50)
         rest = sim.body_clearance()
@@ -147,8 +154,12 @@ def test_body_collision_gives_the_body_its_shapes_and_sees_obstacles(design):
 
 def _contact_moments(sim: SwivelCarSim, joint: str, other: int, axis: np.ndarray,
                      apex: np.ndarray) -> tuple[float, float, np.ndarray]:
-    """Moments about the swivel axis of the normal and the friction forces that body
-    ``other`` puts on the wheel of ``joint`` [N m], and their total force (world) [N]."""
+    """
+    Return the moments about the swivel axis of the contact forces on the wheel of ``joint``.
+
+    The moments [N m] of the normal and the friction forces that body ``other`` puts on the
+    wheel, and their total force (world) [N].
+    """
     link = sim._joint_ids[sim.joint_names.index(joint)]
     normal = friction = 0.0
     force = np.zeros(3)
@@ -165,10 +176,13 @@ def _contact_moments(sim: SwivelCarSim, joint: str, other: int, axis: np.ndarray
 
 def _against_riser(design: CarDescription, drive_speed: float,
                    swivel: float = RISER_SWIVEL) -> dict:
-    """The left front wheel lifted to ``swivel`` [rad] in front of a 45 cm riser that only it
-    meets, the swivel held there by a PID (its integral removes the offset a PD leaves, so
-    both runs hold the same angle); then the drive pushes it against the riser (motor at its
-    torque limit) or stays still. Means over the last second."""
+    """
+    Lift the left front wheel to ``swivel`` [rad] in front of a 45 cm riser that only it meets.
+
+    The swivel is held there by a PID (its integral removes the offset a PD leaves, so both
+    runs hold the same angle); then the drive pushes the wheel against the riser (motor at its
+    torque limit) or stays still. Returns means over the last second.
+    """
     p = design.model_params()
     with SwivelCarSim(SimConfig(description=design, body_collision=True)) as sim:
         sim.spawn_obstacle(StepSpec('riser', 0.45, 0.5, 0.12, 0.23, 0.0, 1.0))

@@ -37,7 +37,8 @@ def test_driving_straight_speed_is_wheel_speed_times_r(sim):
 
 
 def _robot(phi: float, **values) -> CarDescription:
-    """Return the default robot for phi > 0, the phi < 0 design (r = 0.19 m) for phi < 0.
+    """
+    Return the default robot for phi > 0, the phi < 0 design (r = 0.19 m) for phi < 0.
 
     Table 2's wheels with phi = -pi/3 put the apex 5 cm under the ground: the sim (no body
     collision) drove such a car through the floor, a robot that cannot exist.
@@ -237,18 +238,19 @@ def test_commands_are_clamped_to_the_limits(sim):
     assert sim.state().efforts[0] == sim.description.swivel_torque_limit
 
 
-STEP = dict(name='', height=0.1, depth=0.5, width=1.0, distance=0.2, yaw=0.0, friction=0.1)
+STEP = {'name': '', 'height': 0.1, 'depth': 0.5, 'width': 1.0, 'distance': 0.2, 'yaw': 0.0,
+        'friction': 0.1}
 BAD_STEPS = [
-    (dict(height=math.nan), 'height must be finite'),
-    (dict(height=-0.05), 'height must be in'),
-    (dict(height=1.5), 'height must be in'),
-    (dict(depth=0.0), 'depth must be in'),
-    (dict(width=math.inf), 'width must be finite'),
-    (dict(distance=-0.1), 'distance must be >= 0'),
-    (dict(yaw=math.pi / 2), 'yaw must be in'),
-    (dict(friction=0.0), 'friction must be in'),
-    (dict(distance=0.0, height=0.05), 'overlap the robot'),
-    (dict(distance=0.0, yaw=1.2, width=2.0), 'overlap the robot'),
+    ({'height': math.nan}, 'height must be finite'),
+    ({'height': -0.05}, 'height must be in'),
+    ({'height': 1.5}, 'height must be in'),
+    ({'depth': 0.0}, 'depth must be in'),
+    ({'width': math.inf}, 'width must be finite'),
+    ({'distance': -0.1}, 'distance must be >= 0'),
+    ({'yaw': math.pi / 2}, 'yaw must be in'),
+    ({'friction': 0.0}, 'friction must be in'),
+    ({'distance': 0.0, 'height': 0.05}, 'overlap the robot'),
+    ({'distance': 0.0, 'yaw': 1.2, 'width': 2.0}, 'overlap the robot'),
 ]
 
 
@@ -263,7 +265,7 @@ def test_bad_obstacles_are_refused_and_the_world_is_unchanged():
     with SwivelCarSim() as s:
         s.spawn_obstacle(StepSpec(**{**STEP, 'name': 'far', 'distance': 5.0}))
         bodies = pybullet.getNumBodies(physicsClientId=s._client)
-        for change, message in BAD_STEPS + [(dict(name='far'), 'exists already')]:
+        for change, message in BAD_STEPS + [({'name': 'far'}, 'exists already')]:
             with pytest.raises(ValueError, match=message):
                 s.spawn_obstacle(StepSpec(**{**STEP, **change}))
         with pytest.raises(ValueError, match='no obstacle named'):
@@ -322,10 +324,10 @@ def test_bad_reset_is_refused_and_changes_nothing(sim):
 
 
 @pytest.mark.parametrize('change, message', [
-    (dict(time_step=0.0), 'time_step'), (dict(time_step=math.nan), 'time_step'),
-    (dict(ground_friction=-1.0), 'ground_friction'),
-    (dict(watchdog_timeout=-0.1), 'watchdog_timeout'),
-    (dict(robot_variant='boat'), 'robot_variant')])
+    ({'time_step': 0.0}, 'time_step'), ({'time_step': math.nan}, 'time_step'),
+    ({'ground_friction': -1.0}, 'ground_friction'),
+    ({'watchdog_timeout': -0.1}, 'watchdog_timeout'),
+    ({'robot_variant': 'boat'}, 'robot_variant')])
 def test_bad_config_is_refused(change, message):
     with pytest.raises(ValueError, match=message):
         SimConfig(**change)
@@ -395,8 +397,11 @@ def test_show_state_places_the_robot_and_render_draws_it(sim):
 
 
 def _one_rear_wheel_on_ice(rear_differential: str) -> tuple[float, float, float]:
-    """Drive 1 s with every tyre but the rear right one on ice (friction 0.01): (distance
-    [m], rear left and rear right wheel rates [rad/s])."""
+    """
+    Drive 1 s with every tyre but the rear right one on ice (friction 0.01).
+
+    Returns (distance [m], rear left and rear right wheel rates [rad/s]).
+    """
     description = CarDescription(rear_differential=rear_differential,
                                  front_differential='open')
     with SwivelCarSim(SimConfig(description=description)) as s:

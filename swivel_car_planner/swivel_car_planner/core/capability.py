@@ -1,4 +1,5 @@
-"""What the whole car climbs, as measured in physics: the planner's capability table.
+"""
+What the whole car climbs, as measured in physics: the planner's capability table.
 
 The model says how high the *front* wheels can be lifted (thesis eq. 68 and the tip-over rule);
 whether the rear axle follows depends on mass layout, drive train, friction and speed, which
@@ -19,14 +20,13 @@ File format (YAML)::
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, fields
+import math
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from swivel_car_model.description import CarDescription
+import yaml
 
 RELIABLE = 0.9  # [1] success rate that counts as "climbs reliably"
 INSTALLED = 'installed'  # the table shipped in the package's share/config/capability.yaml
@@ -35,12 +35,14 @@ NONE = 'none'  # no table: only the model's limits
 
 @dataclass(frozen=True)
 class CapabilityTable:
-    """Whole-car climbing success by step height for one robot description.
+    """
+    Whole-car climbing success by step height for one robot description.
 
     Raises
     ------
     ValueError
         Inconsistent lists, unsorted or non-positive heights, successes above trials.
+
     """
 
     heights: tuple[float, ...]  # [m], increasing
@@ -63,13 +65,16 @@ class CapabilityTable:
 
     @property
     def rates(self) -> dict[float, float]:
-        """Success rate by height. # {[m]: [1]}"""
+        """Success rate by height {[m]: [1]}."""
         return {h: s / t for h, t, s in zip(self.heights, self.trials, self.successes)}
 
     @property
     def limit(self) -> float:
-        """Highest height of the unbroken run of reliable heights from the lowest; 0 when
-        even the lowest is not reliable. # [m]"""
+        """
+        Highest height of the unbroken run of reliable heights from the lowest [m].
+
+        0 when even the lowest is not reliable.
+        """
         best = 0.0
         for height, rate in self.rates.items():
             if rate < self.reliable:
@@ -78,17 +83,19 @@ class CapabilityTable:
         return best
 
     def matches(self, description: CarDescription) -> bool:
-        """The table was measured on this robot."""
+        """Tell whether the table was measured on this robot."""
         return self.description == description_values(description)
 
     @classmethod
     def load(cls, path: str | Path) -> 'CapabilityTable':
-        """Read a table file.
+        """
+        Read a table file.
 
         Raises
         ------
         ValueError
             The file is missing, not YAML or not a valid table; the message names the file.
+
         """
         try:
             data = yaml.safe_load(Path(path).read_text())
@@ -111,18 +118,21 @@ class CapabilityTable:
 
 
 def description_values(description: CarDescription) -> dict[str, Any]:
-    """The description's fields as plain values (what a table records)."""
+    """Return the description's fields as plain values (what a table records)."""
     return {item.name: getattr(description, item.name) for item in fields(description)}
 
 
 def table_for(value: str) -> tuple[CapabilityTable | None, str]:
-    """The table a ``capability_file`` parameter names, and its path: ``INSTALLED`` (the
-    package's), ``NONE`` (no table: None) or a file path.
+    """
+    Return the table a ``capability_file`` parameter names, and its path.
+
+    The parameter is ``INSTALLED`` (the package's), ``NONE`` (no table: None) or a file path.
 
     Raises
     ------
     ValueError
         The file cannot be read as a table; the message names it.
+
     """
     if value == NONE:
         return None, ''

@@ -1,5 +1,9 @@
-"""Error codes and climb phases, numerically equal to the constants of
-swivel_car_msgs/srv/ClimbStep and action/ClimbStep (a node test checks that they agree)."""
+"""
+Error codes and climb phases, numerically equal to the constants of the ClimbStep interfaces.
+
+Those are swivel_car_msgs/srv/ClimbStep and action/ClimbStep (a node test checks that they
+agree).
+"""
 
 from enum import IntEnum
 

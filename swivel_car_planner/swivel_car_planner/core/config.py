@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, fields
+import math
 
 from swivel_car_model.checks import check_finite_number
 from swivel_car_model.description import described
@@ -11,7 +11,8 @@ from swivel_car_model.description import described
 
 @dataclass(frozen=True)
 class PlannerConfig:
-    """Margins, limits, speeds and monitor thresholds of the climb.
+    """
+    Margins, limits, speeds and monitor thresholds of the climb.
 
     Each field's metadata ``description`` (with its unit) is also its ROS parameter's.
 
@@ -19,6 +20,7 @@ class PlannerConfig:
     ------
     ValueError
         A field is not finite or out of its range; the message names the field.
+
     """
 
     tip_over_margin: float = described(
@@ -42,7 +44,7 @@ class PlannerConfig:
         'heading to the step normal at the lift, turned so the grounded front wheel leads '
         '[rad]')
     push_gap: float = described(
-        0.03, 'push-lift: the grounded front wheel\'s front to the riser when the lift starts '
+        0.03, "push-lift: the grounded front wheel's front to the riser when the lift starts "
         '[m]')
     push_margin: float = described(
         0.05, 'push-lift: the advance ends with the point where the lifted wheel will land '
@@ -69,7 +71,7 @@ class PlannerConfig:
         0.25, 'odometry past the edge beyond rest_margin with the car still pitched: the '
         'rear axle failed to climb [m]')
     edge_margin: float = described(
-        0.05, 'every wheel on top stays this far inside the sides of the step\'s top face '
+        0.05, "every wheel on top stays this far inside the sides of the step's top face "
         '(when the request gives its width) [m]')
     crossing_gain: float = described(
         4.0, 'approach: heading correction per metre of the centre line off its planned '

@@ -1,5 +1,8 @@
-"""The planner's inputs as plain values, ROS-free: what the node takes from each message, and
-the ``Observation`` one synchronised moment (``core.sync.Tick``) makes.
+"""
+The planner's inputs as plain values, ROS-free.
+
+What the node takes from each message, and the ``Observation`` one synchronised moment
+(``core.sync.Tick``) makes.
 
 The planner node calls these on its messages' fields and the in-process stack
 (``swivel_car_bringup.inprocess``) on the cores' outputs, so both hand the state machine the
@@ -26,28 +29,36 @@ RELEASE = Command(0.0, 0.0, 0.0, False)
 
 
 def roll_pitch(x: float, y: float, z: float, w: float) -> tuple[float, float]:
-    """Roll and pitch of a quaternion (REP-103 fixed-axis roll, pitch, yaw). # [rad]"""
+    """Return roll and pitch of a quaternion (REP-103 fixed-axis roll, pitch, yaw) [rad]."""
     roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
     pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
     return roll, pitch
 
 
 def yaw_of(x: float, y: float, z: float, w: float) -> float:
-    """Yaw of a quaternion. # [rad]"""
+    """Return the yaw of a quaternion [rad]."""
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
 def odom_values(x: float, y: float, orientation: Sequence[float],
                 speed: float) -> tuple[float, float, float, float]:
-    """``odom``: position x, y [m], orientation quaternion (x, y, z, w), forward speed
-    [m/s] -> (x [m], y [m], yaw [rad], speed [m/s])."""
+    """
+    Return the planner's values of ``odom``.
+
+    Position x, y [m], orientation quaternion (x, y, z, w), forward speed [m/s] -> (x [m],
+    y [m], yaw [rad], speed [m/s]).
+    """
     return x, y, yaw_of(*orientation), speed
 
 
 def joint_state_values(swivel_joint: str, names: Sequence[str], positions: Sequence[float],
                        velocities: Sequence[float]) -> tuple[float, float] | None:
-    """``joint_states`` -> (swivel angle [rad], swivel rate [rad/s], 0 when not reported);
-    None when the message has no position for ``swivel_joint`` (it is ignored)."""
+    """
+    Return the planner's values of ``joint_states``.
+
+    (swivel angle [rad], swivel rate [rad/s], 0 when not reported); None when the message
+    has no position for ``swivel_joint`` (it is ignored).
+    """
     if swivel_joint not in names:
         return None
     index = list(names).index(swivel_joint)
@@ -68,7 +79,7 @@ def controller_state_values(set_point: float, torque: float) -> tuple[float, flo
 
 
 def observation(tick: Tick) -> Observation:
-    """The state machine's view of one synchronised moment of all ``INPUTS``."""
+    """Make the state machine's view of one synchronised moment of all ``INPUTS``."""
     x, y, yaw, speed = tick.values[ODOM]
     swivel, swivel_rate = tick.values[JOINT_STATES]
     roll, pitch, imu_yaw = tick.values[IMU]
@@ -80,8 +91,10 @@ def observation(tick: Tick) -> Observation:
 
 
 def end_commands(outcome: Outcome) -> list[Command]:
-    """What the planner sends when a climb has ended, after the state machine's last
-    command: after a failure the swivel holds where it is (that last command) and is
-    released, so the controller keeps holding it and cmd_vel steers again."""
-    return [] if outcome.success else [RELEASE]
+    """
+    Return what the planner sends when a climb has ended, after the state machine's last command.
 
+    After a failure the swivel holds where it is (that last command) and is released, so the
+    controller keeps holding it and cmd_vel steers again.
+    """
+    return [] if outcome.success else [RELEASE]

@@ -1,4 +1,5 @@
-"""Feasibility check and climb plan, from the model library (swivel_car_model).
+"""
+Feasibility check and climb plan, from the model library (swivel_car_model).
 
 The model supplies every thesis quantity (swivel angle for a step, lift angle, the tip-over
 rule eq. 72, the interference rule eq. 75, peak torque and energy, the pose change that the
@@ -108,7 +109,8 @@ class PlanError(Exception):
 
 @dataclass(frozen=True)
 class ClimbPlan:
-    """Everything the climb needs, computed before moving.
+    """
+    Everything the climb needs, computed before moving.
 
     The first fields mirror swivel_car_msgs/ClimbPlan; the rest drive the state machine.
     """
@@ -147,13 +149,17 @@ class ClimbPlan:
 
 
 def lead_angle(p: SwivelCarParams, config: PlannerConfig, step_height: float) -> float:
-    """Smallest |heading to the edge's normal| at which the lifted wheel gets over the edge
-    before the other front wheel meets the riser (module docstring). # [rad]
+    """
+    Return the smallest |heading to the edge's normal| that lets the lifted wheel lead [rad].
+
+    At it the lifted wheel gets over the edge before the other front wheel meets the riser
+    (module docstring).
 
     Raises
     ------
     PlanError
         The front wheels are too close together for any angle below ``max_lead_angle``.
+
     """
     sink = p.r - min(step_height, p.r)
     reach = math.sqrt(p.r ** 2 - sink ** 2)
@@ -168,11 +174,15 @@ def lead_angle(p: SwivelCarParams, config: PlannerConfig, step_height: float) ->
 
 def crossing_range(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
                    heading: float) -> tuple[float, float]:
-    """Where along the edge the car's centre line may cross it so that every wheel that is on
-    the step stays on its top face, ``edge_margin`` inside its sides, while the car drives on
-    at ``heading`` (to the normal) until the trailing rear wheel is ``rest_margin`` past the
-    edge, and ``stop_allowance`` further until it stands. Along the edge leftwards from where
-    the request's x axis meets it; empty (low > high) when the face is too narrow. # [m]"""
+    """
+    Return where along the edge the car's centre line may cross it, (low, high) [m].
+
+    So that every wheel that is on the step stays on its top face, ``edge_margin`` inside its
+    sides, while the car drives on at ``heading`` (to the normal) until the trailing rear
+    wheel is ``rest_margin`` past the edge, and ``stop_allowance`` further until it stands.
+    Along the edge leftwards from where the request's x axis meets it; empty (low > high)
+    when the face is too narrow.
+    """
     sine, cosine = math.sin(heading), math.cos(heading)
     # Along the heading from the crossing, the wheels on top lie between the rear axle at
     # the crossing and the front axle once the car stands.
@@ -199,27 +209,34 @@ _ARC_SAMPLES = 400
 def advance_arc(p: SwivelCarParams, config: PlannerConfig, swivel: float, side: int,
                 lead: float, lead_distance: float, reach: float,
                 drift_yaw: float) -> AdvanceArc:
-    """The arc of ADVANCE with the swivel held at ``swivel``: the lifted wheel (rest
-    geometry, as the state machine measures it) moves from ``lead_distance`` short of the
-    edge to ``lead_margin`` past it and ends at a heading at least ``lead`` oblique (signed
-    ``-side``), while the other front wheel stays off the riser (its contact at least
-    ``reach`` short of the edge) when the lift starts (the heading then ``drift_yaw`` before
-    the arc's start), once the wheel is up, and along the arc; at the end of the arc it is
-    ``reach + lead_margin`` short or more, by the lead angle. # [rad], [m]
+    """
+    Find the arc of ADVANCE with the swivel held at ``swivel`` [rad], [m].
+
+    The lifted wheel (rest geometry, as the state machine measures it) moves from
+    ``lead_distance`` short of the edge to ``lead_margin`` past it and ends at a heading at
+    least ``lead`` oblique (signed ``-side``), while the other front wheel stays off the riser
+    (its contact at least ``reach`` short of the edge) when the lift starts (the heading then
+    ``drift_yaw`` before the arc's start), once the wheel is up, and along the arc; at the end
+    of the arc it is ``reach + lead_margin`` short or more, by the lead angle.
 
     Raises
     ------
     PlanError
         ``WHEEL_INTERFERENCE``: no end heading up to ``max_lead_angle`` keeps the other
         wheel off the riser.
+
     """
     curvature = float(planar.curvature_for_swivel(p, swivel))  # [1/m]
     bx, by = p.wheelbase, side * p.h
     travel = lead_distance + config.lead_margin  # [m]
 
     def normal_shift(end: float, length: float | np.ndarray, y: float) -> np.ndarray:
-        """Normal displacement of the base_link point (bx, y) over the last ``length`` of
-        the arc ending at ``end``; sinc keeps the straight limit exact. # [m]"""
+        """
+        Return the normal displacement of the base_link point (bx, y) [m].
+
+        Over the last ``length`` of the arc ending at ``end``; sinc keeps the straight limit
+        exact.
+        """
         start = end - curvature * length
         half = curvature * np.asarray(length) / 2.0
         base = length * np.cos(end - half) * np.sinc(half / np.pi)
@@ -251,15 +268,18 @@ def advance_arc(p: SwivelCarParams, config: PlannerConfig, swivel: float, side: 
     raise PlanError(ErrorCode.WHEEL_INTERFERENCE,
                     f'with the swivel held at {swivel:.2f} rad the lift turns the car by '
                     f'{abs(drift_yaw):.2f} rad and the advance on a {radius:.2f} m radius: at '
-                    f'no heading up to {config.max_lead_angle:.2f} rad to the edge\'s normal '
+                    f"no heading up to {config.max_lead_angle:.2f} rad to the edge's normal "
                     f'does the lifted '
                     f'wheel get over the edge with the other front wheel clear of the riser')
 
 
 def landing_point(p: SwivelCarParams, height: float, side: int) -> tuple[float, float]:
-    """Where in base_link (level) the lifted wheel on ``side`` touches a step of ``height``
-    as the swivel sets it down: its lowest point at the swivel that puts it at that height
-    (it moves back as the swivel comes down from the lift). # [m]"""
+    """
+    Return where in base_link (level) the lifted wheel on ``side`` lands on the step [m].
+
+    Where it touches a step of ``height`` as the swivel sets it down: its lowest point at the
+    swivel that puts it at that height (it moves back as the swivel comes down from the lift).
+    """
     swivel = float(kinematics.swivel_for_step(p, height, respect_tip_over=False))
     x, y, _ = climbing.lifted_wheel_lowest_point(p, side * swivel)
     return float(x), float(y)
@@ -267,16 +287,20 @@ def landing_point(p: SwivelCarParams, height: float, side: int) -> tuple[float, 
 
 def push_advance(p: SwivelCarParams, config: PlannerConfig, swivel: float, side: int,
                  lead_distance: float, drift_yaw: float, height: float) -> AdvanceArc:
-    """The push-lift's advance on the arc of the held ``swivel`` (module docstring): from the
-    heading ``side * push_lead`` at lift, turned by the lift's ``drift_yaw``, until the point
-    where the wheel will land on a step of ``height`` is ``push_margin`` past the edge, the
-    lifted wheel's rest contact ``lead_distance`` short of it when the lift starts. # [rad], [m]
+    """
+    Find the push-lift's advance on the arc of the held ``swivel`` [rad], [m].
+
+    See the module docstring. From the heading ``side * push_lead`` at lift, turned by the
+    lift's ``drift_yaw``, until the point where the wheel will land on a step of ``height``
+    is ``push_margin`` past the edge, the lifted wheel's rest contact ``lead_distance`` short
+    of it when the lift starts.
 
     Raises
     ------
     PlanError
         ``WHEEL_INTERFERENCE``: the grounded wheel's contact would reach the riser first, or
         the arc turns the lifted wheel away before it is over.
+
     """
     lift_heading = side * config.push_lead  # [rad]
     start = lift_heading + drift_yaw  # [rad] once the wheel is up
@@ -357,8 +381,11 @@ def _approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
 
 def _push_approach(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
                    theta2: float, side: int) -> _Approach:
-    """The push-lift's approach (module docstring): the grounded wheel leads at
-    ``push_lead`` and stops ``push_gap`` short of the riser; the swivel lifts to ``theta2``.
+    """
+    Plan the push-lift's approach (module docstring).
+
+    The grounded wheel leads at ``push_lead`` and stops ``push_gap`` short of the riser; the
+    swivel lifts to ``theta2``.
     """
     swivel = side * abs(theta2)
     heading = side * config.push_lead
@@ -379,7 +406,8 @@ _TURN_IN = 1.5  # [1] semi-active turn-in arc per tightest aligning arc (the loo
 
 
 def semi_active_turn(p: SwivelCarParams, config: PlannerConfig) -> tuple[float, float]:
-    """Return the semi-active approach's turn: the arc radius [m], the straight run before it [m].
+    """
+    Return the semi-active approach's turn: the arc radius [m], the straight run before it [m].
 
     The arc is ``_TURN_IN`` times the tightest aligning arc (``max_steer``): the heading loop
     reaches full steering only 0.23 rad of error on: of 8 requests (6 that had failed at 1.0
@@ -398,12 +426,15 @@ def semi_active_turn(p: SwivelCarParams, config: PlannerConfig) -> tuple[float, 
 def _placed(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest, side: int,
             advance: AdvanceArc, heading: float, lead_distance: float,
             axle_normal: float, turn_first: bool = False) -> _Approach:
-    """The approach that lifts at ``heading``, the lifted wheel's rest contact
-    ``lead_distance`` and the front axle's centre ``axle_normal`` short of the edge, then
-    advances on ``advance``: whether there is room to align, and where it crosses the
-    edge. ``turn_first``: aim at the crossing the car reaches by turning onto ``heading`` at
-    once on its tightest arc (the push-lift's large heading; a crossing that assumes an
-    instant turn leaves the car chasing its line at the lift point)."""
+    """
+    Place the approach that lifts at ``heading`` and then advances on ``advance``.
+
+    At the lift the lifted wheel's rest contact is ``lead_distance`` and the front axle's
+    centre ``axle_normal`` short of the edge. The result says whether there is room to align,
+    and where the car crosses the edge. ``turn_first``: aim at the crossing the car reaches by
+    turning onto ``heading`` at once on its tightest arc (the push-lift's large heading; a
+    crossing that assumes an instant turn leaves the car chasing its line at the lift point).
+    """
     psi_lead = advance.end_heading
 
     # Aligning turns on an arc of radius >= wheelbase / tan(max_steer); give it room.
@@ -444,8 +475,8 @@ def _placed(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest, si
         room = reachable[1] - reachable[0]
         if low > high:
             shift = math.inf
-            error = (f'the step\'s top face ({request.step_width:.2f} m wide) is too narrow: '
-                     f'crossing at {psi_lead:.2f} rad to the edge\'s normal the car needs '
+            error = (f"the step's top face ({request.step_width:.2f} m wide) is too narrow: "
+                     f"crossing at {psi_lead:.2f} rad to the edge's normal the car needs "
                      f'{request.step_width + high - low:.2f} m to keep every wheel on it')
         elif shift > 1e-9 and error is None:
             error = (f'the step is too close: the car would cross the edge {shift:.2f} m '
@@ -457,11 +488,19 @@ def _placed(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest, si
 
 def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
               whole_car_limit: float = math.inf) -> ClimbPlan:
-    """Check feasibility and plan the climb of a validated request; ``plan_only`` requests
-    get exactly the same checks.
+    """
+    Check feasibility and plan the climb of a validated request.
+
+    ``plan_only`` requests get exactly the same checks.
 
     Parameters
     ----------
+    p : SwivelCarParams
+        The car's model parameters.
+    config : PlannerConfig
+        The climb settings.
+    request : ClimbRequest
+        The climb asked for, already validated (``validate_request``).
     whole_car_limit : float
         Highest step the whole car climbs reliably (``capability.CapabilityTable.limit``);
         higher ones are refused. # [m]
@@ -472,6 +511,7 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
         With ``UNREACHABLE_HEIGHT``, ``TIP_OVER``, ``WHEEL_INTERFERENCE``, ``TORQUE_LIMIT``
         or ``INVALID_REQUEST`` (the step is too close to align, or its top face too narrow
         for the car) and a message.
+
     """
     height = request.step_height
     max_step, _ = kinematics.max_scalable_step(p, respect_tip_over=True)
@@ -482,13 +522,13 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
     except ValueError as error:
         raise PlanError(ErrorCode.UNREACHABLE_HEIGHT,
                         f'a {height:.3f} m step plus {config.clearance_margin:.3f} m clearance '
-                        f'is beyond the lifted wheel\'s reach ({reach:.3f} m): {error}') \
+                        f"is beyond the lifted wheel's reach ({reach:.3f} m): {error}") \
             from error
     if abs(theta2) > p.swivel_limit:
         limit_height = float(kinematics.lifted_wheel_lowest_height(p, p.swivel_limit))
         raise PlanError(ErrorCode.UNREACHABLE_HEIGHT,
                         f'a {height:.3f} m step plus {config.clearance_margin:.3f} m clearance '
-                        f'needs the swivel at {abs(theta2):.3f} rad, beyond the robot\'s '
+                        f"needs the swivel at {abs(theta2):.3f} rad, beyond the robot's "
                         f'swivel_limit of {p.swivel_limit:.3f} rad (which lifts the wheel '
                         f'{limit_height:.3f} m)')
     if height > whole_car_limit:
@@ -569,13 +609,16 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
 
 def _lift_rules(p: SwivelCarParams, config: PlannerConfig, height: float,
                 theta2: float) -> tuple[float, float, float]:
-    """The lift angle [rad] at the swivel ``theta2`` [rad] and its margins on the tip-over
-    rule [rad] and the wheel interference rule [m].
+    """
+    Return the lift angle [rad] at the swivel ``theta2`` [rad] and its two rule margins.
+
+    The margins are on the tip-over rule [rad] and the wheel interference rule [m].
 
     Raises
     ------
     PlanError
         ``TIP_OVER`` or ``WHEEL_INTERFERENCE`` when a margin is short.
+
     """
     theta1 = float(kinematics.lift_angle(p, theta2))
     tip_margin = float(kinematics.tip_over_margin(p, theta1))
@@ -596,10 +639,13 @@ def _lift_rules(p: SwivelCarParams, config: PlannerConfig, height: float,
 
 def _approaches(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
                 theta2: float, leading: int, push: bool) -> list[_Approach]:
-    """The approaches to choose from, the one that turns the car the least first: the
-    standard lift lifts the wheel that leads already (``leading``), the push-lift the other
-    one. With the step's extent known, both sides: the one whose crossing of the edge lies
-    nearer the top face may win."""
+    """
+    List the approaches to choose from, the one that turns the car the least first.
+
+    The standard lift lifts the wheel that leads already (``leading``), the push-lift the
+    other one. With the step's extent known, both sides: the one whose crossing of the edge
+    lies nearer the top face may win.
+    """
     preferred = -leading if push else leading
     sides = (preferred, -preferred) if request.step_width > 0.0 else (preferred,)
     make, lift = (_push_approach, p.swivel_limit) if push else (_approach, theta2)
@@ -610,8 +656,7 @@ _BACKUP_INCREMENT = 0.05  # [m]
 
 
 def _backups(max_backup: float) -> list[float]:
-    """Backup distances to try, shortest first: 0, then in increments up to ``max_backup``
-    [m]."""
+    """List backup distances to try, shortest first: 0, then steps up to ``max_backup`` [m]."""
     count = int(math.floor(max_backup / _BACKUP_INCREMENT + 1e-9))
     return [0.0] + [i * _BACKUP_INCREMENT for i in range(1, count + 1)] + (
         [max_backup] if max_backup > count * _BACKUP_INCREMENT + 1e-9 else [])

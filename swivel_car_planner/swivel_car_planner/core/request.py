@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 
 from swivel_car_planner.core.codes import ErrorCode
 from swivel_car_planner.core.config import PlannerConfig
@@ -11,7 +11,8 @@ from swivel_car_planner.core.config import PlannerConfig
 
 @dataclass(frozen=True)
 class ClimbRequest:
-    """The fields of srv/ClimbStep and action/ClimbStep's goal.
+    """
+    The fields of srv/ClimbStep and action/ClimbStep's goal.
 
     step_height : height of the step. # [m]
     step_distance : front axle ground contact to the edge along base_link x. # [m]
@@ -34,12 +35,14 @@ class ClimbRequest:
 
 def validate_request(request: ClimbRequest,
                      config: PlannerConfig) -> tuple[ErrorCode, str]:
-    """Check a request's fields; ``(ErrorCode.NONE, '')`` when it is well formed.
+    """
+    Check a request's fields; ``(ErrorCode.NONE, '')`` when it is well formed.
 
     Returns
     -------
     (code, message)
         ``ErrorCode.INVALID_REQUEST`` and a message naming the first bad field.
+
     """
     for name in ('step_height', 'step_distance', 'step_yaw', 'time_allowance', 'step_width',
                  'step_offset'):

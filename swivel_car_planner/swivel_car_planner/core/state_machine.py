@@ -1,4 +1,5 @@
-"""The climb as a pure state machine: observations in, swivel commands and feedback out.
+"""
+The climb as a pure state machine: observations in, swivel commands and feedback out.
 
 One ``update`` per control cycle (the node calls it from a sim-time timer). Steps (and the
 action phase each one reports)::
@@ -173,7 +174,8 @@ class Outcome:
 
 
 class ClimbStateMachine:
-    """Runs one planned climb. Call ``update`` every control cycle until ``outcome`` is set.
+    """
+    Runs one planned climb. Call ``update`` every control cycle until ``outcome`` is set.
 
     Parameters
     ----------
@@ -185,6 +187,7 @@ class ClimbStateMachine:
         The request's edge, relative to the car at the first observation. # [m], [rad]
     time_allowance : float
         Sim time after which the climb aborts with TIMEOUT; 0 = the config's. # [s]
+
     """
 
     def __init__(self, p: SwivelCarParams, config: PlannerConfig, plan: ClimbPlan,
@@ -243,8 +246,12 @@ class ClimbStateMachine:
         self._cancel_requested = True
 
     def abort(self, code: ErrorCode, message: str) -> Command | None:
-        """End the climb between observations (its inputs stopped): the drive stops and the
-        swivel holds where it was last seen; None if it was never observed."""
+        """
+        End the climb between observations (its inputs stopped).
+
+        The drive stops and the swivel holds where it was last seen; None if it was never
+        observed.
+        """
         if self.outcome is not None:
             return self._final_command()
         if self._last is None:
@@ -388,8 +395,11 @@ class ClimbStateMachine:
         return self._open_loop(obs.swivel, config.rear_speed, free=True)
 
     def _attitude_steady(self, obs: Observation) -> bool:
-        """The IMU's pitch and roll have stayed within ``settle_rate * settle_time`` of each
-        other for ``settle_time`` (the swivel's at-rest rate and time, applied to the body).
+        """
+        Tell whether the IMU's pitch and roll have held steady for ``settle_time``.
+
+        Steady: within ``settle_rate * settle_time`` of each other (the swivel's at-rest rate
+        and time, applied to the body).
 
         Odometry's speed alone does not say the car stands: a rear wheel that rode up onto
         the riser's corner stops turning while the car still rocks on it, and the wheels can
@@ -410,7 +420,7 @@ class ClimbStateMachine:
         return config.settle_time <= 0.0
 
     def _not_on_top_message(self, obs: Observation) -> str:
-        """What the planner saw of a car standing tilted after the rear step."""
+        """Describe what the planner saw of a car standing tilted after the rear step."""
         message = (f'the car came to rest pitched {obs.pitch:.3f} rad, rolled '
                    f'{obs.roll:.3f} rad although odometry puts the rear wheels '
                    f'{self._rear_wheel_distance(obs):.2f} m past the edge: a wheel is not on '
@@ -428,15 +438,17 @@ class ClimbStateMachine:
         return Step.BACK_UP if self._plan.backup_distance > 0.0 else Step.APPROACH
 
     def _backed_up(self, obs: Observation) -> float:
-        """How far the car is behind where the climb was asked, along its x axis then. # [m]
-        """
+        """Return how far the car is behind where the climb was asked, along its x then [m]."""
         origin = self._origin
         return -((obs.x - origin.x) * math.cos(origin.yaw)
                  + (obs.y - origin.y) * math.sin(origin.yaw))
 
     def _approach_heading(self, obs: Observation) -> float:
-        """The planned approach heading, corrected towards the planned crossing of the edge
-        when the step's extent is known (a line through the crossing at that heading). # [rad]
+        """
+        Return the planned approach heading, corrected towards the planned crossing [rad].
+
+        Corrected only when the step's extent is known (a line through the crossing of the edge
+        at that heading).
         """
         plan = self._plan
         if plan.crossing is None:
@@ -457,7 +469,8 @@ class ClimbStateMachine:
         return heading - min(limit, max(-limit, correction))
 
     def _turn_in(self, off_line: float) -> float:
-        """Return the heading [rad] to a line ``off_line`` [m] away that meets it tangentially.
+        """
+        Return the heading [rad] to a line ``off_line`` [m] away that meets it tangentially.
 
         Straight on while the swivel turns to ``max_steer``, then on the arc
         ``semi_active_turn`` plans with: ``R (1 - cos d) + L sin d = off_line``. The
@@ -471,7 +484,8 @@ class ClimbStateMachine:
                 - math.atan2(delay, radius))
 
     def _steer(self, obs: Observation, heading: float, drive_speed: float) -> Command:
-        """Drive at ``drive_speed`` steering towards ``heading`` (to the edge normal).
+        """
+        Drive at ``drive_speed`` steering towards ``heading`` (to the edge normal).
 
         For phi < 0 the swivel's own move yaws the car against the turn it steers
         (``dynamics.swivel_pose_drift``: 0.22 rad the other way on the phi < 0 design for a
@@ -498,7 +512,8 @@ class ClimbStateMachine:
 
     def _ramp(self, obs: Observation, angle: float, drive_speed: float,
               then_hold: bool = False) -> Command:
-        """Command a ramp at ``swivel_rate`` towards ``angle`` while driving at ``drive_speed``.
+        """
+        Command a ramp at ``swivel_rate`` towards ``angle`` while driving at ``drive_speed``.
 
         From the swivel where the step began: the set point and the command stay together, so
         the controller keeps driving. No outer loop (``then_hold``: the outer loop of ``_hold``
@@ -515,8 +530,10 @@ class ClimbStateMachine:
         return command
 
     def _hold(self, obs: Observation, angle: float, drive_speed: float) -> Command:
-        """Bring the measured swivel to ``angle`` (outer loop, see the module docstring)
-        while driving at ``drive_speed``.
+        """
+        Bring the measured swivel to ``angle`` while driving at ``drive_speed``.
+
+        This is the outer loop (see the module docstring).
 
         The bias integrates only once the controller's rate-limited set point has reached the
         last command: while it still ramps, the error is the ramp's, not the load's.
@@ -533,7 +550,7 @@ class ClimbStateMachine:
         return Command(self._last_command, config.swivel_rate, drive_speed, True)
 
     def _settled(self, obs: Observation, target: float) -> bool:
-        """The swivel is at ``target`` and at rest for ``settle_time``."""
+        """Tell whether the swivel is at ``target`` and at rest for ``settle_time``."""
         config = self._config
         if (abs(obs.swivel - target) <= config.swivel_tolerance
                 and abs(obs.swivel_rate) <= config.settle_rate):
@@ -575,7 +592,8 @@ class ClimbStateMachine:
     # --- geometry -------------------------------------------------------------------------
 
     def _wheel_distance(self, obs: Observation, bx: float, by: float) -> float:
-        """Signed distance past the edge of a wheel's contact given at rest in base_link.
+        """
+        Signed distance past the edge of a wheel's contact given at rest in base_link.
 
         The rest geometry ignores how the swivel moves the front contacts (a few cm at the
         lift angles); ``lead_margin`` and ``lift_gap`` absorb it.
@@ -584,22 +602,25 @@ class ClimbStateMachine:
         return self._edge.signed_distance(*pose.transform(bx, by))
 
     def _heading(self, obs: Observation) -> float:
-        """The car's heading in the odometry frame, from the IMU (module docstring). # [rad]"""
+        """Return the car's heading in the odometry frame from the IMU (module docstring) [rad]."""
         return wrap_angle(obs.imu_yaw - self._yaw_offset)
 
     def _lifted_wheel_distance(self, obs: Observation) -> float:
         return self._wheel_distance(obs, self._p.wheelbase, self._plan.lifted_side * self._p.h)
 
     def _advance_distance(self, obs: Observation) -> float:
-        """What ADVANCE drives until it reaches ``_advance_goal``: the lifted wheel's rest
-        contact past the edge, or for a push-lift the point where it will land. # [m]
+        """
+        Return what ADVANCE drives until it reaches ``_advance_goal`` [m].
+
+        The lifted wheel's rest contact past the edge, or for a push-lift the point where it
+        will land.
         """
         if self._plan.push_lift:
             return self._wheel_distance(obs, *self._plan.lifted_point)
         return self._lifted_wheel_distance(obs)
 
     def _advance_goal(self) -> float:
-        """# [m] see ``_advance_distance``"""
+        """Return the goal of ``_advance_distance`` [m]."""
         config = self._config
         return config.push_margin if self._plan.push_lift else config.lead_margin
 
@@ -607,7 +628,7 @@ class ClimbStateMachine:
         return self._wheel_distance(obs, self._p.wheelbase, -self._plan.lifted_side * self._p.h)
 
     def _rear_wheel_distance(self, obs: Observation) -> float:
-        """The rear wheel nearer the riser (the trailing one). # [m]"""
+        """Return the distance past the edge of the rear wheel nearer the riser (trailing) [m]."""
         return min(self._wheel_distance(obs, 0.0, self._p.h),
                    self._wheel_distance(obs, 0.0, -self._p.h))
 
@@ -675,7 +696,7 @@ class ClimbStateMachine:
         if self._step == Step.REAR and abs(slip) > config.slip_yaw_tolerance:
             return (ErrorCode.NO_PROGRESS,
                     f'the wheels slip: the IMU heading has turned {slip:+.2f} rad away from '
-                    f'the odometry\'s in {name}')
+                    f"the odometry's in {name}")
         if self._step in _DRIVING:
             ref_time, ref_path = self._progress_ref
             if self._path - ref_path >= config.min_progress:

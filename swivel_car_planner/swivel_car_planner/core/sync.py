@@ -1,4 +1,5 @@
-"""Matching the planner's inputs by their stamps, so that each climb step sees one moment.
+"""
+Matching the planner's inputs by their stamps, so that each climb step sees one moment.
 
 The planner acts once per controller state (the controller answers every joint_states). For
 a tick at time t it takes, from every input topic, the newest message stamped at or before t,
@@ -11,8 +12,8 @@ rates it waits at most one period of the slowest input.
 from __future__ import annotations
 
 from collections import deque
-import math
 from dataclasses import dataclass
+import math
 from typing import Any, Iterable
 
 
@@ -25,7 +26,8 @@ class Tick:
 
 
 class InputSync:
-    """Collects stamped inputs and hands out the ticks whose inputs are complete.
+    """
+    Collects stamped inputs and hands out the ticks whose inputs are complete.
 
     Parameters
     ----------
@@ -35,6 +37,7 @@ class InputSync:
         The topic whose messages make ticks.
     depth : int
         Messages kept per topic, and ticks kept waiting; older ones are dropped.
+
     """
 
     def __init__(self, topics: Iterable[str], tick_topic: str, depth: int = 50) -> None:
@@ -49,7 +52,8 @@ class InputSync:
         self._last_tick = -math.inf  # [s]
 
     def add(self, topic: str, stamp: float, value: Any) -> list[Tick]:
-        """Take one message (stamp [s]); returns the ticks it completed, oldest first.
+        """
+        Take one message (stamp [s]); returns the ticks it completed, oldest first.
 
         A stamp older than the topic's newest means time went back (a sim reset): everything
         collected so far is dropped.
