@@ -23,10 +23,12 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
+from std_msgs.msg import Header
 from swivel_car_model import description
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
+from swivel_car_planner import planner_node
 from swivel_car_planner.core import Command, ErrorCode, Phase, PlannerConfig
 from swivel_car_planner.planner_node import PlannerNode
 from swivel_car_testing import next_domain_id, spin_until
@@ -53,7 +55,10 @@ class Rig:
         self.planner = PlannerNode_with_sim_time(self.context)
         self.planner_executor = SingleThreadedExecutor(context=self.context)
         self.planner_executor.add_node(self.planner)
-        self.thread = threading.Thread(target=self.planner_executor.spin, daemon=True)
+        # Stopped before the executor is shut down: shutdown() destroys the executor's guard
+        # condition, which a spin() still running in this thread may trigger.
+        self._stop = threading.Event()
+        self.thread = threading.Thread(target=self._spin_planner, daemon=True)
         self.thread.start()
         self.node = rclpy.create_node('robot', context=self.context)
         self.executor = SingleThreadedExecutor(context=self.context)
@@ -75,6 +80,10 @@ class Rig:
         self.action = ActionClient(self.node, ClimbStepAction, 'climb_step')
         spin_until(self.executor, self.service.service_is_ready, 10.0, 'the service')
         spin_until(self.executor, self.action.server_is_ready, 10.0, 'the action server')
+
+    def _spin_planner(self):
+        while not self._stop.is_set():
+            self.planner_executor.spin_once(timeout_sec=0.05)
 
     def _on_command(self, msg):
         self.received.append(msg)
@@ -152,12 +161,13 @@ class Rig:
         return self.service.call_async(ClimbStepService.Request(**fields))
 
     def close(self):
+        self._stop.set()
+        self.thread.join(5.0)
         self.action.destroy()
         self.planner_executor.shutdown()
         self.planner.destroy_node()
         self.node.destroy_node()
         rclpy.shutdown(context=self.context)
-        self.thread.join(5.0)
 
 
 def PlannerNode_with_sim_time(context):  # noqa: N802
@@ -348,6 +358,112 @@ def test_a_moment_far_ahead_is_not_acted_on(rig):
     assert 'leapt' in response.message
     # Nothing was steered on it: the only answers after it stop and release.
     assert all(not m.hold or m.drive_speed == 0.0 for m in rig.received[before:])
+
+
+class _HeldPlans:
+    """The planner's make_plan, held until ``release`` for climbs; plan_only plans at once."""
+
+    def __init__(self, monkeypatch):
+        self.started = threading.Event()
+        self._gate = threading.Event()
+        real = planner_node.make_plan
+
+        def make_plan(robot, config, request, whole_car_limit):
+            if not request.plan_only:
+                self.started.set()
+                self._gate.wait(60.0)  # a guard: a failed test must not hang
+            return real(robot, config, request, whole_car_limit)
+
+        monkeypatch.setattr(planner_node, 'make_plan', make_plan)
+
+    def release(self):
+        self._gate.set()
+
+
+@pytest.fixture
+def held_plans(monkeypatch):
+    plans = _HeldPlans(monkeypatch)
+    yield plans
+    plans.release()
+
+
+def start_held_climb(rig, held_plans, call):
+    rig.warm_up()
+    future = call()
+    spin_until(rig.executor, held_plans.started.is_set, 10.0, 'the planning')
+    return future
+
+
+def test_the_node_answers_while_a_climb_is_planned(rig, held_plans):
+    climb = start_held_climb(rig, held_plans, lambda: rig.call(**SUCCESSFUL_CLIMB))
+    # Each answered while the plan is held: the executor is free.
+    plan_only = result_of(rig, rig.call(**SUCCESSFUL_CLIMB, plan_only=True))
+    assert plan_only.success, plan_only.message
+    busy = result_of(rig, rig.call(**SUCCESSFUL_CLIMB))
+    assert busy.error_code == ErrorCode.BUSY
+    assert 'planned' in busy.message
+    assert not send_goal(rig, [], **SUCCESSFUL_CLIMB).accepted
+    assert not climb.done() and rig.received == []
+    held_plans.release()
+    response = rig.drive(climb)
+    assert response.success, response.message
+
+
+def test_a_goal_canceled_while_planned_never_moves(rig, held_plans):
+    handle = start_held_climb(rig, held_plans, lambda: send_goal(rig, [], **SUCCESSFUL_CLIMB))
+    result_future = handle.get_result_async()
+    cancel = handle.cancel_goal_async()
+    spin_until(rig.executor, cancel.done, 10.0, 'the cancel response')
+    held_plans.release()
+    wrapped = result_of(rig, result_future)
+    assert wrapped.status == GoalStatus.STATUS_CANCELED
+    assert wrapped.result.error_code == ErrorCode.CANCELED
+    assert rig.received == []
+
+
+def publish_reset_event(rig):
+    """As the sim's reset: the event names the next state, the first of the new world."""
+    publisher = rig.node.create_publisher(Header, 'sim/reset_event', 10)
+    spin_until(rig.executor, lambda: publisher.get_subscription_count() > 0, 10.0,
+               'the planner on sim/reset_event')
+    stamp = rig.car.time
+    publisher.publish(Header(stamp=rclpy.time.Time(nanoseconds=rig.car.cycles * 10**7).to_msg(),
+                             frame_id='world'))
+    return stamp
+
+
+def test_a_sim_reset_ends_the_climb_with_the_car_stopped(rig):
+    rig.warm_up()
+    future = rig.call(**SUCCESSFUL_CLIMB)
+    rig.drive(_Deadline(rig, 1.0))
+    assert rig.received[-1].hold and rig.received[-1].drive_speed > 0.0  # driving
+    before = len(rig.received)
+    stamp = publish_reset_event(rig)
+    response = result_of(rig, future)
+    assert response.error_code == ErrorCode.NOT_READY
+    assert 'reset' in response.message
+    # Only the release, for the new world: drive 0, the controller holds the swivel where it
+    # measures it (a hold would turn it to the old world's angle).
+    spin_until(rig.executor, lambda: len(rig.received) > before, 10.0, 'the release')
+    (release,) = rig.received[before:]
+    assert not release.hold and release.drive_speed == 0.0
+    assert rclpy.time.Time.from_msg(release.header.stamp).nanoseconds * 1e-9 == \
+        pytest.approx(stamp)
+    # The world goes on without the climb: its states are not answered.
+    rig.warm_up(cycles=5)
+    assert len(rig.received) == before + 1
+
+
+def test_a_sim_reset_while_planned_ends_the_climb_before_it_moves(rig, held_plans):
+    climb = start_held_climb(rig, held_plans, lambda: rig.call(**SUCCESSFUL_CLIMB))
+    publish_reset_event(rig)
+    # Heard before the plan is done: the reset world is not climbed in.
+    rig.warm_up(cycles=5)
+    held_plans.release()
+    response = result_of(rig, climb)
+    assert response.error_code == ErrorCode.NOT_READY
+    assert 'reset' in response.message
+    assert rig.received == []
 
 
 class _Deadline:
