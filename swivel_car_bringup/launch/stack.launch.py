@@ -1,5 +1,7 @@
-"""The whole stack: sim, controller, odometry, planner and the robot on the graph, optionally a
-recording and a live view (for a full Jazzy install with launch_ros).
+"""
+The whole stack: sim, controller, odometry, planner and the robot on the graph.
+
+Optionally a recording and a live view (for a full Jazzy install with launch_ros).
 
 ros2 launch swivel_car_bringup stack.launch.py [record:=true] [bag:=my_run]
     [foxglove:=true] [foxglove_port:=8765] [gui:=true] [robot_variant:=swivel]

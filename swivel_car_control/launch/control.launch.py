@@ -1,4 +1,5 @@
-"""Start the swivel car's controller and odometry (for a full Jazzy install with launch_ros).
+"""
+Start the swivel car's controller and odometry (for a full Jazzy install with launch_ros).
 
 ros2 launch swivel_car_control control.launch.py [use_sim_time:=true] [namespace:=robot1]
     [use_stamped:=true] [controller_params:=...] [odometry_params:=...]
