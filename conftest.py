@@ -1,4 +1,5 @@
-"""Root conftest: import the stack's packages before pytest collects their tests.
+"""
+Root conftest: import the stack's packages before pytest collects their tests.
 
 With --import-mode=importlib pytest names a test module after its path
 (swivel_car_sim/test/test_physics.py -> swivel_car_sim.test.test_physics) and puts empty
@@ -10,16 +11,30 @@ Hypothesis draws the same examples on every run, so a test run's result depends 
 alone (HYPOTHESIS_PROFILE=explore draws new ones, for looking for bugs by hand).
 """
 
+import importlib
 import os
 
 from hypothesis import settings
 
-import swivel_car_bringup  # noqa: F401
-import swivel_car_control  # noqa: F401
-import swivel_car_model  # noqa: F401
-import swivel_car_planner  # noqa: F401
-import swivel_car_sim  # noqa: F401
+for package in ('swivel_car_bringup', 'swivel_car_control', 'swivel_car_model',
+                'swivel_car_planner', 'swivel_car_sim'):
+    importlib.import_module(package)
 
 settings.register_profile('deterministic', derandomize=True)
 settings.register_profile('explore', derandomize=False)
 settings.load_profile(os.environ.get('HYPOTHESIS_PROFILE', 'deterministic'))
+
+
+# Files whose results still depend on the machine's load, so `make test` runs them alone after
+# the files run side by side (marked `alone`). The routes' odometry is outside the lockstep
+# chain of a sim paced at 6x and skips states when another worker takes its core (end error
+# 0.06-0.60 m against 0.05 m alone); this goes once the odometry and the route driver take part
+# in the chain.
+_ALONE = {'swivel_car_control/test/test_system_routes.py'}
+
+
+def pytest_collection_modifyitems(items) -> None:
+    """Mark the tests of the files in ``_ALONE``."""
+    for item in items:
+        if item.nodeid.split('::')[0] in _ALONE:
+            item.add_marker('alone')

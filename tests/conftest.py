@@ -13,7 +13,7 @@ from swivel_car_testing import next_domain_id
 
 @pytest.fixture
 def ros_domain() -> Iterator[tuple[int, Context]]:
-    """A fresh ROS_DOMAIN_ID and an rclpy context initialised on it, shut down afterwards."""
+    """Give a fresh ROS_DOMAIN_ID and an rclpy context on it, shut down afterwards."""
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     domain_id = next_domain_id()
     context = Context()

@@ -1,6 +1,8 @@
-"""Helpers for tests that run the real nodes: isolated ROS domains, node processes
-started the way `ros2 run` starts them (from scripts/swivel_car_stack.py), and spinning
-until a condition holds.
+"""
+Helpers for tests that run the real nodes.
+
+Isolated ROS domains, node processes started the way `ros2 run` starts them (from
+scripts/swivel_car_stack.py), and spinning until a condition holds.
 
 Import from any test (the root pytest.ini puts tests/support and scripts on sys.path).
 """
@@ -10,13 +12,17 @@ from __future__ import annotations
 import fcntl
 import itertools
 import os
-import tempfile
 from pathlib import Path
+import tempfile
 from typing import IO
 
-from swivel_car_stack import (  # noqa: F401  (re-exported for the tests)
-    INSTALL_DIR, REPO_ROOT, NodeProcess, config_path, executable_path, lockstep_parameters,
+from swivel_car_stack import (
+    config_path, executable_path, INSTALL_DIR, lockstep_parameters, NodeProcess, REPO_ROOT,
     ros_environment, spin_until, start_node)
+
+__all__ = ['config_path', 'executable_path', 'INSTALL_DIR', 'lockstep_parameters',
+           'next_domain_id', 'NodeProcess', 'REPO_ROOT', 'ros_environment', 'spin_until',
+           'start_node']
 
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
 # stragglers are never heard. Every process (a pytest-xdist worker, another pytest, the
@@ -45,8 +51,11 @@ def _claim_block() -> int:
 
 
 def next_domain_id() -> int:
-    """A ROS_DOMAIN_ID that no other process using this helper on this host has, and not
-    used by the previous nine calls in this process."""
+    """
+    Return a ROS_DOMAIN_ID that no other process using this helper on this host has.
+
+    Nor did the previous nine calls in this process return it.
+    """
     global _domain_ids
     if _domain_ids is None:
         base = 1 + 10 * _claim_block()
