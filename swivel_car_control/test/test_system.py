@@ -167,7 +167,9 @@ def test_cmd_vel_moves_the_car_as_commanded(stack):
     driver.command = (math.nan, 0.0)
     start, end = driver.drive(0.3, (math.nan, 0.0))
     assert _yaw_rate(start, end) == pytest.approx(-0.8, rel=0.15)
-    assert 'rejected' in controller.output()
+    # The controller process writes the warning when it gets to it: under load, after the drive.
+    spin_until(driver.executor, lambda: 'rejected' in controller.output(), 10.0,
+               'the warning for the non-finite command')
 
     # Deadman: with no more commands the drive stops and the swivel holds.
     driver.drive(DEADMAN + 1.0, None)
