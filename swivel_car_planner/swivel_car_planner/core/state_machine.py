@@ -196,6 +196,8 @@ class ClimbStateMachine:
         self._config = config
         self._plan = plan
         self._semi_active = plan.procedure == PROCEDURE_SEMI_ACTIVE
+        # (arc radius [m], straight run before it [m]) of the semi-active approach's turn-in
+        self._turn = semi_active_turn(p, config) if self._semi_active else (0.0, 0.0)
         self._step_distance = step_distance
         self._step_yaw = step_yaw
         self._allowance = time_allowance if time_allowance > 0.0 else config.time_allowance
@@ -478,7 +480,7 @@ class ClimbStateMachine:
         car turned in 0.2 m short of its line and met it still turning, the swivel at its
         steering limit; the phi < 0 swivel's own yaw, against the turn, delays every turn.
         """
-        radius, delay = semi_active_turn(self._p, self._config)
+        radius, delay = self._turn
         norm = math.hypot(radius, delay)
         return (math.acos(max(-1.0, min(1.0, (radius - off_line) / norm)))
                 - math.atan2(delay, radius))
