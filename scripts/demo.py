@@ -33,6 +33,7 @@ from swivel_car_msgs.action import ClimbStep
 from swivel_car_msgs.msg import StepObstacle
 from swivel_car_msgs.srv import SpawnObstacle
 from swivel_car_planner.core import capability
+from swivel_car_ros.ros_params import stamp_to_seconds
 from swivel_car_sim.physics import StepSpec
 from swivel_car_stack import (
     lockstep_parameters, NodeProcess, REPO_ROOT, spin_until, start_node)
@@ -54,10 +55,6 @@ NODE_PARAMETERS = {executable: {'use_sim_time': True,
                                 **lockstep_parameters(executable, LOCKSTEP_TIMEOUT)}
                    for _, executable in NODES}
 NODE_PARAMETERS['sim_node']['gui'] = False
-
-
-def stamp_seconds(stamp) -> float:
-    return stamp.sec + 1e-9 * stamp.nanosec
 
 
 class DemoNode(Node):
@@ -82,11 +79,11 @@ class DemoNode(Node):
     def _on_truth(self, msg: Odometry) -> None:
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
         self.recording.truth.append(
-            (stamp_seconds(msg.header.stamp), p.x, p.y, p.z, q.x, q.y, q.z, q.w))
+            (stamp_to_seconds(msg.header.stamp), p.x, p.y, p.z, q.x, q.y, q.z, q.w))
 
     def _on_odom(self, msg: Odometry) -> None:
         p = msg.pose.pose.position
-        self.recording.odom.append((stamp_seconds(msg.header.stamp), p.x, p.y))
+        self.recording.odom.append((stamp_to_seconds(msg.header.stamp), p.x, p.y))
 
     def drive(self, speed: float) -> None:
         msg = TwistStamped()

@@ -17,13 +17,13 @@ from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
-from swivel_car_control.conversions import is_zero_stamp, stamp_to_seconds
+from swivel_car_control.conversions import is_zero_stamp
 from swivel_car_control.core.controller import ControllerConfig, SwivelController
 from swivel_car_control.core.joint_states import JointStateController
 from swivel_car_control.joints import MissingJointError
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
 from swivel_car_ros.ros_params import (
-    declare_dataclass, declare_description, live_parameters, run_node)
+    declare_dataclass, declare_description, live_parameters, run_node, stamp_to_seconds)
 
 # A cmd_vel stamped further than this ahead of the node clock is taken as arriving now.
 _CLOCK_SLACK = 0.5  # [s]

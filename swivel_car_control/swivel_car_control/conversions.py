@@ -8,11 +8,6 @@ from geometry_msgs.msg import Quaternion
 from swivel_car_control.core.joint_states import yaw_quaternion
 
 
-def stamp_to_seconds(stamp: Time) -> float:
-    """Convert a builtin_interfaces/Time to seconds [s]."""
-    return stamp.sec + stamp.nanosec * 1e-9
-
-
 def is_zero_stamp(stamp: Time) -> bool:
     return stamp.sec == 0 and stamp.nanosec == 0
 

@@ -17,14 +17,14 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Empty
-from swivel_car_control.conversions import stamp_to_seconds, yaw_to_quaternion
+from swivel_car_control.conversions import yaw_to_quaternion
 from swivel_car_control.core.joint_states import JointStateOdometry, YAW_RATE_SOURCES
 from swivel_car_control.core.odometry_input import (
     GatedOdometry, MAX_SWIVEL_RATE, Verdict, WHEEL_RATE_FACTOR)
 from swivel_car_control.joints import MissingJointError
 from swivel_car_msgs.srv import SetPose2D
 from swivel_car_ros.ros_params import (
-    declare_dataclass, declare_description, live_parameters, run_node)
+    declare_dataclass, declare_description, live_parameters, run_node, stamp_to_seconds)
 
 
 @dataclass(frozen=True)

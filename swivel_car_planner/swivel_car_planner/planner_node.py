@@ -41,7 +41,7 @@ from swivel_car_planner.core import (
     capability, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs, make_plan,
     PlanError, PlannerConfig, validate_request)
 from swivel_car_planner.core.sync import InputSync, Tick
-from swivel_car_ros.ros_params import declare_description, run_node
+from swivel_car_ros.ros_params import declare_description, run_node, stamp_to_seconds
 
 _CONTROLLER_STATE = inputs.CONTROLLER_STATE
 _INPUTS = inputs.INPUTS
@@ -270,7 +270,7 @@ class PlannerNode(Node):
     def _add(self, topic: str, msg, value: tuple) -> None:
         self._received[topic] = self._now()
         stamp = msg.header.stamp
-        for tick in self._sync.add(topic, stamp.sec + 1e-9 * stamp.nanosec, value):
+        for tick in self._sync.add(topic, stamp_to_seconds(stamp), value):
             self._on_tick(tick)
 
     def _missing_inputs(self) -> list[str]:
@@ -433,7 +433,7 @@ class PlannerNode(Node):
         climb = self._climb
         if climb is None:
             return
-        stamp = msg.stamp.sec + 1e-9 * msg.stamp.nanosec  # [s]
+        stamp = stamp_to_seconds(msg.stamp)  # [s]
         climb.machine.abort(ErrorCode.NOT_READY,
                             f'the sim was reset at {stamp:.2f} s: the climb does not go on in '
                             f'the reset world')

@@ -1,5 +1,5 @@
 """
-ROS glue shared by the nodes: config dataclasses as parameters, the main loop.
+ROS glue shared by the nodes: config dataclasses as parameters, the main loop, stamps.
 
 Parameters the ROS 2 way: each is read-only (``ros2 param set`` prints "Trying to set a
 read-only parameter") unless its node applies it while running (``live_parameters``); a live
@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any, Callable, Collection, Mapping, TypeVar
 
+from builtin_interfaces.msg import Time
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 import rclpy
 from rclpy.exceptions import ParameterException
@@ -21,6 +22,11 @@ from swivel_car_model import description
 from swivel_car_model.description import CarDescription
 
 T = TypeVar('T')
+
+
+def stamp_to_seconds(stamp: Time) -> float:
+    """Convert a builtin_interfaces/Time to seconds [s]."""
+    return stamp.sec + stamp.nanosec * 1e-9
 
 
 def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],
