@@ -34,6 +34,7 @@ from std_srvs.srv import Empty, SetBool
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
+from swivel_car_ros.ros_params import stamp_to_seconds
 from swivel_car_testing import (
     lockstep_parameters, next_domain_id, NodeProcess, spin_until, start_node)
 
@@ -48,10 +49,6 @@ LOCKSTEP_TIMEOUT = 0.1  # [s]
 # (max_linear_acceleration 1 m/s^2) then takes to stop the car from 0.3 m/s.
 DEADMAN = 0.5  # [s]
 BRAKING = 0.3  # [s]
-
-
-def seconds(stamp) -> float:
-    return stamp.sec + 1e-9 * stamp.nanosec  # [s]
 
 
 def time_msg(t: float) -> Time:
@@ -153,12 +150,12 @@ class Stack:
                              'sim/reset')
         assert response.success, response.message
         self.spin_until(lambda: len(self.resets) > count, 30.0, 'sim/reset_event')
-        reset_time = seconds(self.resets[-1].stamp)
+        reset_time = stamp_to_seconds(self.resets[-1].stamp)
         self.spin_until(lambda: self.sim_time() >= reset_time, 30.0, 'the reset state')
         return reset_time
 
     def sim_time(self) -> float:
-        return seconds(self.truth[-1].header.stamp)
+        return stamp_to_seconds(self.truth[-1].header.stamp)
 
     def wait_sim_time(self, duration: float, what: str) -> None:
         end = self.sim_time() + duration
@@ -313,10 +310,10 @@ def test_a_sim_reset_leaves_the_car_at_rest_until_a_new_command(stack: Stack):
     assert abs(stack.controller_states[-1].measured) > 0.3, 'the swivel did not turn'
     reset_time = stack.reset()
     stack.wait_sim_time(1.0, 'the reset car to stand')
-    states = [s for s in stack.controller_states if seconds(s.header.stamp) >= reset_time]
+    states = [s for s in stack.controller_states if stamp_to_seconds(s.header.stamp) >= reset_time]
     assert states and all(abs(s.measured) < 0.02 and s.drive_speed == 0.0
                           and s.source == 'hold' for s in states), states[-1]
-    truth = [t for t in stack.truth if seconds(t.header.stamp) >= reset_time]
+    truth = [t for t in stack.truth if stamp_to_seconds(t.header.stamp) >= reset_time]
     assert all(abs(t.pose.pose.position.x) < 0.01 and abs(t.pose.pose.position.y) < 0.01
                for t in truth), truth[-1].pose.pose.position
     stack.drive(0.3, 1.0)
@@ -353,7 +350,7 @@ def test_killed_sim_mid_drive_and_a_new_sim_moves_only_on_a_new_cmd_vel(stack: S
     new_world = stack.sim_time() - 0.5  # [s] stamps below this after the kill: the new sim
 
     def new(messages: list, count: int) -> list:
-        return [m for m in messages[count:] if seconds(m.header.stamp) < new_world]
+        return [m for m in messages[count:] if stamp_to_seconds(m.header.stamp) < new_world]
 
     # The user's cmd_vel stops with the sim. A new sim (its clock from 0, the robot at the
     # origin): the controller drops what it was given in the old one and holds the car...
