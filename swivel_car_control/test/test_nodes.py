@@ -13,6 +13,7 @@ from nav_msgs.msg import Odometry
 import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
 from std_srvs.srv import Empty
@@ -416,3 +417,14 @@ def test_cmd_vel_out_is_in_the_base_frame_id():
         assert out[-1].header.frame_id == 'robot1/base_link'
     finally:
         harness.close()
+
+
+def test_an_empty_base_frame_id_is_refused_naming_it():
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=next_domain_id())
+    try:
+        with pytest.raises(ValueError, match='base_frame_id'):
+            ControllerNode(context=context,
+                           parameter_overrides=[Parameter('base_frame_id', value='')])
+    finally:
+        rclpy.try_shutdown(context=context)
