@@ -323,16 +323,29 @@ def _robot(args: argparse.Namespace) -> dict:
     return robot
 
 
+def _height(text: str) -> float:
+    """Read one step height or height increment [m] of the command line: finite, > 0."""
+    value = float(text)
+    if not (math.isfinite(value) and value > 0.0):
+        raise argparse.ArgumentTypeError(f'must be a finite height > 0 m, got {text}')
+    return value
+
+
+def _height_list(text: str) -> list[float]:
+    """Read comma-separated step heights [m] of the command line (empty items skipped)."""
+    return [_height(item) for item in text.split(',') if item]
+
+
 def _heights(args: argparse.Namespace) -> list[float]:
     return args.heights or heights(args.min_height, args.max_height, args.step)
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--min-height', type=float, default=0.02, help='[m]')
-    parser.add_argument('--max-height', type=float, default=0.20, help='[m]')
-    parser.add_argument('--step', type=float, default=0.01, help='[m]')
-    parser.add_argument('--heights', type=lambda text: [float(v) for v in text.split(',')],
+    parser.add_argument('--min-height', type=_height, default=0.02, help='[m]')
+    parser.add_argument('--max-height', type=_height, default=0.20, help='[m]')
+    parser.add_argument('--step', type=_height, default=0.01, help='[m]')
+    parser.add_argument('--heights', type=_height_list,
                         metavar='H1,H2,...', help='[m] these heights instead of the range')
     parser.add_argument('--trials', type=int, default=8, help='attempted climbs per height')
     parser.add_argument('--max-draws', type=int, default=4,
@@ -358,7 +371,7 @@ def main(argv: list[str] | None = None) -> None:
                         help='one controller parameter, e.g. max_linear_velocity=1.0')
     parser.add_argument('--skip-car-like', action='store_true')
     parser.add_argument('--phi-negative-heights', default='0.04,0.05,0.06,0.07,0.08',
-                        type=lambda text: [float(v) for v in text.split(',') if v],
+                        type=_height_list,
                         metavar='H1,H2,...',
                         help="[m] then the phi < 0 design's table (semi-active procedure, "
                              'config/designs/phi_negative.yaml, body colliding) at these '

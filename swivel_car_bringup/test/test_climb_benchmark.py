@@ -38,7 +38,10 @@ def test_each_shipped_design_has_a_table_measured_on_it():
     ('--set=bogus=2', 'unknown robot description parameter'),
     ('--set=body_mass=heavy', 'body_mass'),
     ('--controller=bogus=1', 'unknown controller parameter'),
-    ('--planner=rear_speed=-1', 'rear_speed must be >= 0')])
+    ('--planner=rear_speed=-1', 'rear_speed must be >= 0'),
+    ('--phi-negative-heights=0.05,-0.05', 'must be a finite height > 0 m, got -0.05'),
+    ('--max-height=inf', 'must be a finite height > 0 m, got inf'),
+    ('--step=0', 'must be a finite height > 0 m, got 0')])
 def test_a_bad_override_is_a_usage_error_before_any_climb(option, message, capsys):
     with pytest.raises(SystemExit) as exit_:
         main(['--heights', '0.02', '--trials', '1', '--skip-car-like', option])
