@@ -5,10 +5,11 @@ The core's ``ClimbStateMachine`` steps once per controller state, on the inputs 
 moment (``core.sync``), and the command it answers carries that moment's stamp: in a lockstep
 sim the controller applies it exactly one cycle later (its ``lockstep_swivel_command``), so a
 climb does not depend on how busy the machine is. The service and action callbacks are
-coroutines that await the climb's future, so the climb blocks nothing: a single-threaded
-executor serves everything. (Blocking callbacks on a MultiThreadedExecutor made its spin loop
-busy-wait at full CPU while a climb ran.) Planning itself still runs in the callback: seconds of
-CPU when a backup is searched.
+coroutines that await the plan's and the climb's futures, so nothing blocks the executor: a
+single-threaded one serves everything. (Blocking callbacks on a MultiThreadedExecutor made its
+spin loop busy-wait at full CPU while a climb ran.) Planning takes seconds of CPU when a backup
+is searched: it runs on a worker thread, whose result the executor takes through a guard
+condition.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 import math
 import sys
+import threading
 import time
 
 from nav_msgs.msg import Odometry
@@ -70,6 +72,53 @@ class _Result:
         return message
 
 
+class _PlanWorker:
+    """
+    Plans on worker threads; each plan's future completes on the node's executor.
+
+    A plan still running when the node is destroyed is dropped (its thread is a daemon).
+    """
+
+    def __init__(self, node: Node) -> None:
+        self._lock = threading.Lock()
+        self._finished: list[tuple[Future, object, Exception | None]] = []  # (future, plan, error)
+        self._closed = False
+        self._guard = node.create_guard_condition(self._complete)
+
+    def plan(self, robot, config: PlannerConfig, request: ClimbRequest,
+             whole_car_limit: float) -> Future:
+        """Start ``make_plan`` on a thread; its future gets the plan, or the PlanError raised."""
+        future = Future()
+
+        def work() -> None:
+            plan = error = None
+            try:
+                plan = make_plan(robot, config, request, whole_car_limit)
+            except Exception as raised:  # the awaiting callback raises it
+                error = raised
+            with self._lock:
+                if self._closed:
+                    return
+                self._finished.append((future, plan, error))
+                self._guard.trigger()
+
+        threading.Thread(target=work, name='climb_step planning', daemon=True).start()
+        return future
+
+    def close(self) -> None:
+        with self._lock:
+            self._closed = True
+
+    def _complete(self) -> None:
+        with self._lock:
+            finished, self._finished = self._finished, []
+        for future, plan, error in finished:
+            if error is None:
+                future.set_result(plan)
+            else:
+                future.set_exception(error)
+
+
 class PlannerNode(Node):
     """Serves ``climb_step`` (service and action); publishes ``swivel_command``."""
 
@@ -101,6 +150,9 @@ class PlannerNode(Node):
                                 read_only=True)).value
 
         self._climb: _ActiveClimb | None = None
+        self._planning = False  # a climb's plan is being made (the climb slot is taken)
+        self._resets = 0  # sim/reset_events heard
+        self._plans = _PlanWorker(self)
         self._received: dict[str, float] = {}  # topic -> sim time of its last message [s]
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
         self._last_tick = 0.0  # [s] node clock when the running climb last had a tick
@@ -129,7 +181,7 @@ class PlannerNode(Node):
         self.create_timer(self._ready_timeout / 4.0, self._check_sim_alive,
                           clock=Clock(clock_type=ClockType.STEADY_TIME))
         # The model's swivel drift is integrated once per robot (a second); done now, the first
-        # climb request does not hold the executor up while the stack waits for its commands.
+        # climb's planning does not take that second longer.
         dynamics.swivel_pose_drift(self.robot, 0.0, self.robot.max_swivel_angle)
         self.get_logger().info(
             f'planner ready: model max scalable step {self._max_step():.3f} m, torque limit '
@@ -235,27 +287,39 @@ class PlannerNode(Node):
         code, message = validate_request(request, self.config)
         if code != ErrorCode.NONE:
             return self._failure(code, message)
-        missing = [] if request.plan_only else self._missing_inputs()
+        if request.plan_only:
+            try:
+                plan = await self._plan(request)
+            except PlanError as error:
+                return self._failure(error.code, error.message)
+            return _Result(True, int(ErrorCode.NONE), 'plan only: the robot did not move',
+                           plan_to_msg(plan), ClimbOutcome())
+        missing = self._missing_inputs()
         if missing:
             return self._failure(ErrorCode.NOT_READY,
                                  f'no recent message on {", ".join(missing)}: are the sim, '
                                  f'controller and odometry running?')
+        if self._busy():
+            return self._failure(ErrorCode.BUSY, 'a climb is already being planned or running')
+        resets = self._resets
+        self._planning = True
         try:
-            plan = make_plan(self.robot, self.config, request, self.whole_car_limit)
+            plan = await self._plan(request)
         except PlanError as error:
             return self._failure(error.code, error.message)
-        if request.plan_only:
-            return _Result(True, int(ErrorCode.NONE), 'plan only: the robot did not move',
-                           plan_to_msg(plan), ClimbOutcome())
+        finally:
+            self._planning = False
+        if goal_handle is not None and goal_handle.is_cancel_requested:
+            return self._failure(ErrorCode.CANCELED, 'canceled while planning: nothing moved')
+        if self._resets != resets:
+            return self._failure(ErrorCode.NOT_READY, 'the sim was reset while the climb was '
+                                 'planned: nothing moved, ask again in the new world')
         climb = _ActiveClimb(
             ClimbStateMachine(self.robot, self.config, plan, request.step_distance,
                               request.step_yaw, request.time_allowance),
             Future(), goal_handle)
-        if self._climb is not None:
-            return self._failure(ErrorCode.BUSY, 'a climb is already running')
-        # The climb starts from the moments after this one: planning may have held the
-        # executor up (seconds, when a backup is searched), and a tick of the inputs
-        # collected before it would be that old.
+        # The climb starts from the moments after its planning (seconds, when a backup is
+        # searched): a tick of the inputs collected before would be that old.
         self._sync.clear()
         self._climb = climb
         self._last_tick = self._now()
@@ -274,6 +338,12 @@ class PlannerNode(Node):
                                       f'{outcome.message}')
         return _Result(outcome.success, int(outcome.error_code), outcome.message,
                        plan_to_msg(plan), outcome_to_msg(outcome))
+
+    def _plan(self, request: ClimbRequest) -> Future:
+        return self._plans.plan(self.robot, self.config, request, self.whole_car_limit)
+
+    def _busy(self) -> bool:
+        return self._planning or self._climb is not None
 
     def _failure(self, code: ErrorCode, message: str) -> _Result:
         self.get_logger().warning(f'climb_step refused ({code.name}): {message}')
@@ -317,7 +387,7 @@ class PlannerNode(Node):
 
         The controller's swivel_command deadman has stopped the car by then.
         Only after two checks in a row without a tick: after the executor was held up (a
-        long plan), this timer runs before the queued inputs and would see a stale tick.
+        loaded machine), this timer runs before the queued inputs and would see a stale tick.
         """
         climb = self._climb
         if climb is None:
@@ -359,6 +429,7 @@ class PlannerNode(Node):
         controller, reset by the same event, holds the swivel where it measures it then with
         the drive stopped; the usual stop would hold the swivel at the old world's angle.
         """
+        self._resets += 1
         climb = self._climb
         if climb is None:
             return
@@ -412,8 +483,9 @@ class PlannerNode(Node):
         return result.fill(response)
 
     def _on_goal(self, goal) -> GoalResponse:
-        if self._climb is not None and not goal.plan_only:
-            self.get_logger().warning('climb_step goal rejected: a climb is already running')
+        if self._busy() and not goal.plan_only:
+            self.get_logger().warning(
+                'climb_step goal rejected: a climb is already being planned or running')
             return GoalResponse.REJECT
         return GoalResponse.ACCEPT
 
@@ -432,6 +504,7 @@ class PlannerNode(Node):
         return result.fill(ClimbStepAction.Result())
 
     def destroy_node(self) -> None:
+        self._plans.close()
         self._action.destroy()
         super().destroy_node()
 

@@ -28,6 +28,7 @@ from swivel_car_model import description
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
+from swivel_car_planner import planner_node
 from swivel_car_planner.core import Command, ErrorCode, Phase, PlannerConfig
 from swivel_car_planner.planner_node import PlannerNode
 from swivel_car_testing import next_domain_id, spin_until
@@ -359,17 +360,65 @@ def test_a_moment_far_ahead_is_not_acted_on(rig):
     assert all(not m.hold or m.drive_speed == 0.0 for m in rig.received[before:])
 
 
-class _Deadline:
-    """A future-like that is done once the rig's car reaches ``seconds`` of sim time."""
+class _HeldPlans:
+    """The planner's make_plan, held until ``release`` for climbs; plan_only plans at once."""
 
-    def __init__(self, rig, seconds):
-        self._rig, self._end = rig, rig.car.time + seconds
+    def __init__(self, monkeypatch):
+        self.started = threading.Event()
+        self._gate = threading.Event()
+        real = planner_node.make_plan
 
-    def done(self):
-        return self._rig.car.time >= self._end
+        def make_plan(robot, config, request, whole_car_limit):
+            if not request.plan_only:
+                self.started.set()
+                self._gate.wait(60.0)  # a guard: a failed test must not hang
+            return real(robot, config, request, whole_car_limit)
 
-    def result(self):
-        return None
+        monkeypatch.setattr(planner_node, 'make_plan', make_plan)
+
+    def release(self):
+        self._gate.set()
+
+
+@pytest.fixture
+def held_plans(monkeypatch):
+    plans = _HeldPlans(monkeypatch)
+    yield plans
+    plans.release()
+
+
+def start_held_climb(rig, held_plans, call):
+    rig.warm_up()
+    future = call()
+    spin_until(rig.executor, held_plans.started.is_set, 10.0, 'the planning')
+    return future
+
+
+def test_the_node_answers_while_a_climb_is_planned(rig, held_plans):
+    climb = start_held_climb(rig, held_plans, lambda: rig.call(**SUCCESSFUL_CLIMB))
+    # Each answered while the plan is held: the executor is free.
+    plan_only = result_of(rig, rig.call(**SUCCESSFUL_CLIMB, plan_only=True))
+    assert plan_only.success, plan_only.message
+    busy = result_of(rig, rig.call(**SUCCESSFUL_CLIMB))
+    assert busy.error_code == ErrorCode.BUSY
+    assert 'planned' in busy.message
+    assert not send_goal(rig, [], **SUCCESSFUL_CLIMB).accepted
+    assert not climb.done() and rig.received == []
+    held_plans.release()
+    response = rig.drive(climb)
+    assert response.success, response.message
+
+
+def test_a_goal_canceled_while_planned_never_moves(rig, held_plans):
+    handle = start_held_climb(rig, held_plans, lambda: send_goal(rig, [], **SUCCESSFUL_CLIMB))
+    result_future = handle.get_result_async()
+    cancel = handle.cancel_goal_async()
+    spin_until(rig.executor, cancel.done, 10.0, 'the cancel response')
+    held_plans.release()
+    wrapped = result_of(rig, result_future)
+    assert wrapped.status == GoalStatus.STATUS_CANCELED
+    assert wrapped.result.error_code == ErrorCode.CANCELED
+    assert rig.received == []
 
 
 def publish_reset_event(rig):
@@ -403,6 +452,31 @@ def test_a_sim_reset_ends_the_climb_with_the_car_stopped(rig):
     # The world goes on without the climb: its states are not answered.
     rig.warm_up(cycles=5)
     assert len(rig.received) == before + 1
+
+
+def test_a_sim_reset_while_planned_ends_the_climb_before_it_moves(rig, held_plans):
+    climb = start_held_climb(rig, held_plans, lambda: rig.call(**SUCCESSFUL_CLIMB))
+    publish_reset_event(rig)
+    # Heard before the plan is done: the reset world is not climbed in.
+    rig.warm_up(cycles=5)
+    held_plans.release()
+    response = result_of(rig, climb)
+    assert response.error_code == ErrorCode.NOT_READY
+    assert 'reset' in response.message
+    assert rig.received == []
+
+
+class _Deadline:
+    """A future-like that is done once the rig's car reaches ``seconds`` of sim time."""
+
+    def __init__(self, rig, seconds):
+        self._rig, self._end = rig, rig.car.time + seconds
+
+    def done(self):
+        return self._rig.car.time >= self._end
+
+    def result(self):
+        return None
 
 
 def test_config_file_matches_the_declared_defaults():
