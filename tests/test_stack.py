@@ -211,7 +211,9 @@ class Stack:
                 self.climb.remove_pending_request(future)
                 assert time.monotonic() < deadline, 'the planner never answered'
                 continue
-            if future.result().error_code != ClimbStep.Response.ERROR_NOT_READY:
+            # BUSY: the planner still plans a request of this loop whose answer was given up.
+            if future.result().error_code not in (ClimbStep.Response.ERROR_NOT_READY,
+                                                  ClimbStep.Response.ERROR_BUSY):
                 assert future.result().error_code == \
                     ClimbStep.Response.ERROR_UNREACHABLE_HEIGHT, future.result().message
                 return
