@@ -393,6 +393,7 @@ class InProcessStack:
             self.car, c.steer_joint, c.rear_left_wheel_joint, c.rear_right_wheel_joint,
             c.yaw_rate_source, c.odometry_publish_rate)
         self._sync = InputSync(inputs.INPUTS, inputs.CONTROLLER_STATE)
+        self._command_heard = -math.inf  # [s] stamp of the last swivel_command
         self.machine: ClimbStateMachine | None = None
         self._steps: list[tuple[float, str]] = []
         self._cmd_vel: tuple[float, float] | None = None
@@ -536,7 +537,7 @@ class InProcessStack:
                 o.x, o.y, yaw_quaternion(o.yaw), o.v))
         if out is not None:
             ticks += self._sync.add(inputs.CONTROLLER_STATE, t, inputs.controller_state_values(
-                out.set_point, out.swivel_torque))
+                out.set_point, out.swivel_torque, self._command_heard))
         for tick in ticks:
             self._on_tick(tick)
 
@@ -561,6 +562,7 @@ class InProcessStack:
 
     def _command_swivel(self, command: Command, stamp: float) -> None:
         """swivel_command to the controller; it applies it from its next answer."""
+        self._command_heard = stamp
         try:
             self.controller.core.set_swivel_command(
                 float(command.angle), float(command.max_rate), float(command.drive_speed),

@@ -11,19 +11,20 @@ import math
 import sys
 import time
 
+from builtin_interfaces.msg import Time as TimeMsg
 from geometry_msgs.msg import Twist, TwistStamped
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
-from swivel_car_control.conversions import is_zero_stamp
 from swivel_car_control.core.controller import ControllerConfig, SwivelController
 from swivel_car_control.core.joint_states import JointStateController
 from swivel_car_control.joints import MissingJointError
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
 from swivel_car_ros.ros_params import (
-    declare_dataclass, declare_description, live_parameters, run_node, stamp_to_seconds)
+    declare_dataclass, declare_description, is_zero_stamp, live_parameters, moment_seconds,
+    run_node, stamp_to_seconds)
 
 # A cmd_vel stamped further than this ahead of the node clock is taken as arriving now.
 _CLOCK_SLACK = 0.5  # [s]
@@ -92,7 +93,7 @@ class ControllerNode(Node):
                         self._core.reconfigure)
         self._joint_states = JointStateController(self._core, swivel_joint)
         self._warned_zero_stamp = False
-        self._heard_command_time = -math.inf  # [s] stamp of the last stamped swivel_command
+        self._heard_command_stamp = TimeMsg()  # of the last stamped swivel_command (zero: none)
         self._held_stamped = False  # the held swivel_command came stamped: it takes part in
         # the lockstep
         self._pending: JointState | None = None  # joint_states waiting for that command
@@ -163,7 +164,7 @@ class ControllerNode(Node):
         stamped = not is_zero_stamp(msg.header.stamp)
         if stamped:
             # Even a refused command answers its cycle: the lockstep wait is over.
-            self._heard_command_time = stamp_to_seconds(msg.header.stamp)
+            self._heard_command_stamp = msg.header.stamp
             self._planner_late = False
         try:
             # The deadman counts from receipt: a planner that lags behind a lockstep sim
@@ -193,6 +194,7 @@ class ControllerNode(Node):
             return
         if self._pending is not None and stamp_to_seconds(self._pending.header.stamp) < t:
             self._pending = None  # a state of the old world: the sim waits for it no more
+        self._heard_command_stamp = TimeMsg()
         self.get_logger().info(f'the sim was reset at {t:.3f} s: commands dropped, the swivel '
                                'held where it is measured then, drive stopped, until a new '
                                'command')
@@ -208,7 +210,8 @@ class ControllerNode(Node):
         if (not self._lockstep_swivel_command or self._planner_late or last_time is None
                 or self._core.swivel_command is None or not self._held_stamped):
             return False
-        return stamp_to_seconds(msg.header.stamp) > last_time > self._heard_command_time
+        return (stamp_to_seconds(msg.header.stamp) > last_time
+                > moment_seconds(self._heard_command_stamp))
 
     def _take_pending(self) -> JointState:
         msg, self._pending = self._pending, None
@@ -270,6 +273,7 @@ class ControllerNode(Node):
         state.saturated = out.pid.saturated
         state.drive_speed = out.drive_speed
         state.source = out.source
+        state.swivel_command_stamp = self._heard_command_stamp
         self._state_pub.publish(state)
 
         limited = TwistStamped()

@@ -189,7 +189,9 @@ def test_a_sim_reset_event_restarts_the_controller_from_the_state_after_it(contr
     reset = controller.probe.create_publisher(Header, 'sim/reset_event', 10)
     controller.wait_connected(reset)
     step(controller, 1.0)
-    controller.swivel.publish(SwivelCommand(angle=0.5, drive_speed=1.0, hold=True))
+    command = stamped_swivel_command(1.0, 0.5)
+    command.drive_speed = 1.0
+    controller.swivel.publish(command)
     for k in range(1, 10):
         step(controller, 1.0 + 0.01 * k, swivel=0.5)
     controller.swivel.publish(SwivelCommand(hold=False))
@@ -204,6 +206,7 @@ def test_a_sim_reset_event_restarts_the_controller_from_the_state_after_it(contr
     spin_until(controller.executor, lambda: states[-1].header.stamp == joint_state(1.29)
                .header.stamp, 10.0, 'the last state')
     assert states[-1].source == 'hold' and states[-1].target == 0.0
+    assert states[-1].swivel_command_stamp == Time()  # the old world's command: forgotten
 
 
 def stamped_swivel_command(t, angle, hold=True):
@@ -236,7 +239,10 @@ def test_lockstep_waits_for_the_planners_command_of_the_previous_state():
         for _ in range(20):  # the first command is taken whenever it comes
             harness.executor.spin_once(timeout_sec=0.01)
         step(harness, 1.01)
-        assert state_of(1.01).target == pytest.approx(0.3)
+        state = state_of(1.01)
+        assert state.target == pytest.approx(0.3)
+        # It says which command it heard: the planner's sign that the chain holds.
+        assert state.swivel_command_stamp == joint_state(1.0).header.stamp
 
         # The command answering 1.01 has not come: 1.02 waits for it, then takes it.
         harness.joints.publish(joint_state(1.02))
@@ -275,6 +281,7 @@ def test_lockstep_waits_for_the_planners_command_of_the_previous_state():
             harness.joints.publish(joint_state(t))
             state = state_of(t, 1.5)  # well within lockstep_wait: no wait
         assert state.target == pytest.approx(0.2)
+        assert state.swivel_command_stamp == joint_state(1.05).header.stamp  # zero: not one
     finally:
         harness.close()
 

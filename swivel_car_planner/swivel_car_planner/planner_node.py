@@ -14,11 +14,12 @@ condition.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 import math
 import sys
 import threading
 import time
+from typing import Callable
 
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
@@ -41,7 +42,8 @@ from swivel_car_planner.core import (
     capability, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs, make_plan,
     PlanError, PlannerConfig, validate_request)
 from swivel_car_planner.core.sync import InputSync, Tick
-from swivel_car_ros.ros_params import declare_description, run_node, stamp_to_seconds
+from swivel_car_ros.ros_params import (
+    declare_description, moment_seconds, run_node, stamp_to_seconds)
 
 _CONTROLLER_STATE = inputs.CONTROLLER_STATE
 _INPUTS = inputs.INPUTS
@@ -49,11 +51,24 @@ _INPUTS = inputs.INPUTS
 
 @dataclass
 class _ActiveClimb:
-    """The one running climb, and who waits for it."""
+    """
+    The one running climb, and who waits for it.
 
-    machine: ClimbStateMachine
+    It is engaged once the controller has heard its first command: from then on the
+    controller (in the lockstep chain) waits for each of its commands, so its ticks come one
+    control period apart.
+    """
+
+    new_machine: Callable[[], ClimbStateMachine]
     done: Future
     goal_handle: ServerGoalHandle | None = None
+    machine: ClimbStateMachine = field(init=False)
+    first_command: tuple[Command, float] | None = None  # (command, stamp [s])
+    engaged: bool = False
+    waited: bool = False  # ticks passed between the first command and the engagement
+
+    def __post_init__(self) -> None:
+        self.machine = self.new_machine()
 
 
 @dataclass
@@ -157,7 +172,7 @@ class PlannerNode(Node):
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
         self._last_tick = 0.0  # [s] node clock when the running climb last had a tick
         self._last_tick_wall = 0.0  # [s] steady clock then
-        self._last_tick_stamp = -math.inf  # [s] the stamp of that tick's inputs
+        self._last_tick_stamp = -math.inf  # [s] the stamp of the climb's last engaged tick
         self._quiet_checks = 0  # input checks in a row that saw no tick
         self._quiet_wall_checks = 0
 
@@ -264,8 +279,8 @@ class PlannerNode(Node):
         self._add(inputs.IMU, msg, inputs.imu_values((q.x, q.y, q.z, q.w)))
 
     def _on_controller_state(self, msg: SwivelControllerState) -> None:
-        self._add(_CONTROLLER_STATE, msg, inputs.controller_state_values(msg.set_point,
-                                                                         msg.torque))
+        self._add(_CONTROLLER_STATE, msg, inputs.controller_state_values(
+            msg.set_point, msg.torque, moment_seconds(msg.swivel_command_stamp)))
 
     def _add(self, topic: str, msg, value: tuple) -> None:
         self._received[topic] = self._now()
@@ -315,8 +330,8 @@ class PlannerNode(Node):
             return self._failure(ErrorCode.NOT_READY, 'the sim was reset while the climb was '
                                  'planned: nothing moved, ask again in the new world')
         climb = _ActiveClimb(
-            ClimbStateMachine(self.robot, self.config, plan, request.step_distance,
-                              request.step_yaw, request.time_allowance),
+            lambda: ClimbStateMachine(self.robot, self.config, plan, request.step_distance,
+                                      request.step_yaw, request.time_allowance),
             Future(), goal_handle)
         # The climb starts from the moments after its planning (seconds, when a backup is
         # searched): a tick of the inputs collected before would be that old.
@@ -361,8 +376,9 @@ class PlannerNode(Node):
             return
         if math.isfinite(self._last_tick_stamp) \
                 and tick.time - self._last_tick_stamp > self._ready_timeout:
-            # Consecutive states are a control period apart: a leap is a bad stamp or a
-            # clock that jumped, and acting on it would time out or steer on a lie.
+            # Engaged, consecutive states are a control period apart: a leap is a bad stamp,
+            # a clock that jumped or a planner the controller gave up waiting for, and acting
+            # on it would time out or steer on a lie.
             self._abort(climb, self._last_tick_stamp, ErrorCode.NOT_READY,
                         f'the inputs leapt from {self._last_tick_stamp:.2f} s to '
                         f'{tick.time:.2f} s, more than ready_timeout ({self._ready_timeout} '
@@ -370,11 +386,30 @@ class PlannerNode(Node):
             return
         self._last_tick = self._now()
         self._last_tick_wall = time.monotonic()
-        self._last_tick_stamp = tick.time
         self._quiet_checks = self._quiet_wall_checks = 0
+        if climb.first_command is not None and not climb.engaged:
+            command, first_stamp = climb.first_command
+            if inputs.command_heard(tick) < first_stamp:
+                # Until the controller waits for the planner, the sim may run ahead of it by
+                # any time: the first command stands for each such moment.
+                climb.waited = True
+                self._publish_command(command, tick.time)
+                return
+            climb.engaged = True
+            if climb.waited:
+                # The moment the first command answered is gone: the climb starts afresh
+                # from this one, which the controller holds.
+                climb.machine = climb.new_machine()
+                self.get_logger().info(
+                    f'the controller heard the first command of {first_stamp:.2f} s only at '
+                    f'{tick.time:.2f} s: the climb starts from there')
+        if climb.engaged:
+            self._last_tick_stamp = tick.time
         if climb.goal_handle is not None and climb.goal_handle.is_cancel_requested:
             climb.machine.cancel()
         command = climb.machine.update(inputs.observation(tick))
+        if climb.first_command is None:
+            climb.first_command = (command, tick.time)
         self._publish_command(command, tick.time)
         if climb.goal_handle is not None:
             climb.goal_handle.publish_feedback(self._feedback_msg(climb.machine.feedback))
@@ -390,8 +425,8 @@ class PlannerNode(Node):
         loaded machine), this timer runs before the queued inputs and would see a stale tick.
         """
         climb = self._climb
-        if climb is None:
-            return
+        if climb is None or not climb.engaged:
+            return  # the sim is not held back for the planner yet: sim time may race
         self._quiet_checks += 1
         now = self._now()
         if self._quiet_checks < 2 or now - self._last_tick <= self._ready_timeout:

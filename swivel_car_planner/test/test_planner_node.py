@@ -14,6 +14,7 @@ import threading
 import time
 
 from action_msgs.msg import GoalStatus
+from builtin_interfaces.msg import Time as TimeMsg
 from kinematic_car import DEFAULT_SWIVEL_RATE, DT, KinematicCar
 from nav_msgs.msg import Odometry
 import pytest
@@ -69,6 +70,7 @@ class Rig:
                             SUCCESSFUL_CLIMB['step_yaw'])
         self.command = None
         self.received: list[SwivelCommand] = []
+        self.heard = TimeMsg()  # the stamp of the last command, as the controller reports it
         self.node.create_subscription(SwivelCommand, 'swivel_command', self._on_command, 10)
         self.clock = self.node.create_publisher(Clock, '/clock', 10)
         self.joints = self.node.create_publisher(JointState, 'joint_states', 10)
@@ -87,13 +89,19 @@ class Rig:
 
     def _on_command(self, msg):
         self.received.append(msg)
+        self.heard = msg.header.stamp
         # Only the answer to the state just published: a late answer to an earlier one
         # would put the car out of step with the planner.
         if rclpy.time.Time.from_msg(msg.header.stamp).nanoseconds == self.car.cycles * 10**7:
             self.command = Command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold)
 
-    def publish_state(self, inputs=('joint_states', 'imu', 'odom', 'controller')):
-        """One control cycle of the robot: clock, then the requested inputs."""
+    def publish_state(self, inputs=('joint_states', 'imu', 'odom', 'controller'),
+                      heard=None):
+        """
+        Publish one control cycle of the robot: clock, then the requested inputs.
+
+        ``heard``: the command stamp the controller state reports (default: the last command's).
+        """
         car = self.car
         stamp = rclpy.time.Time(nanoseconds=car.cycles * 10_000_000).to_msg()
         self.clock.publish(Clock(clock=stamp))
@@ -122,7 +130,9 @@ class Rig:
             self.odom.publish(msg)
         if 'controller' in inputs:
             msg = SwivelControllerState(set_point=car.set_point, measured=car.swivel,
-                                        torque=obs.torque, source='hold')
+                                        torque=obs.torque, source='hold',
+                                        swivel_command_stamp=self.heard if heard is None
+                                        else heard)
             msg.header.stamp = stamp
             self.state.publish(msg)
 
@@ -358,6 +368,35 @@ def test_a_moment_far_ahead_is_not_acted_on(rig):
     assert 'leapt' in response.message
     # Nothing was steered on it: the only answers after it stop and release.
     assert all(not m.hold or m.drive_speed == 0.0 for m in rig.received[before:])
+
+
+def test_a_sim_running_ahead_of_the_first_command_does_not_end_the_climb(rig):
+    """
+    Check the planner repeats its first command until the controller has heard it.
+
+    Until then the controller does not wait for the planner, so a loaded planner may hear
+    its next state seconds later (seen on a loaded CI machine); only from then on is a leap
+    a fault.
+    """
+    rig.warm_up()
+    future = rig.call(**SUCCESSFUL_CLIMB)
+    deadline = time.monotonic() + 10.0
+    while not rig.received and time.monotonic() < deadline:
+        rig.publish_state(heard=TimeMsg())
+        rig.executor.spin_once(timeout_sec=0.05)
+    assert rig.received, 'no first command'
+    first = rig.received[-1]
+    rig.car.cycles += 250  # [10 ms] the sim ran ahead: the controller had not heard it
+    rig.publish_state(heard=TimeMsg())
+    spin_until(rig.executor, lambda: rig.received[-1] is not first, 10.0, 'the next command')
+    repeated = rig.received[-1]
+    assert rclpy.time.Time.from_msg(repeated.header.stamp).nanoseconds == rig.car.cycles * 10**7
+    assert (repeated.angle, repeated.drive_speed, repeated.hold) == (
+        first.angle, first.drive_speed, first.hold)
+    rig.car.apply(rig.command)  # the controller heard it now, and waits for the planner
+    rig.command = None
+    response = rig.drive(future)
+    assert response.success, response.message
 
 
 class _HeldPlans:

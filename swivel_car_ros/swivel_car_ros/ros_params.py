@@ -9,6 +9,7 @@ one set to a bad value is refused with the reason.
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any, Callable, Collection, Mapping, TypeVar
 
 from builtin_interfaces.msg import Time
@@ -27,6 +28,16 @@ T = TypeVar('T')
 def stamp_to_seconds(stamp: Time) -> float:
     """Convert a builtin_interfaces/Time to seconds [s]."""
     return stamp.sec + stamp.nanosec * 1e-9
+
+
+def is_zero_stamp(stamp: Time) -> bool:
+    """Tell whether ``stamp`` is zero: unset, or no such moment."""
+    return stamp.sec == 0 and stamp.nanosec == 0
+
+
+def moment_seconds(stamp: Time) -> float:
+    """Return ``stamp`` in seconds [s], -inf for the zero stamp (no such moment yet)."""
+    return -math.inf if is_zero_stamp(stamp) else stamp_to_seconds(stamp)
 
 
 def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],

@@ -35,7 +35,9 @@ except ImportError:  # outside pytest: the repository's helpers (pytest.ini puts
 from swivel_car_stack import lockstep_parameters, NodeProcess, start_node
 
 CLIMB_WALL_LIMIT = 600.0  # [s] guard against a hung stack, not a measurement
-LOCKSTEP_TIMEOUT = 2.0  # [s] wall
+# [s] wall; half of it the controller waits for the planner. A loaded CI machine held a
+# node up for seconds: within it, the climb stays deterministic.
+LOCKSTEP_TIMEOUT = 6.0
 
 
 class SimSession:

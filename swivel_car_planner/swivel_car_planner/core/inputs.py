@@ -73,9 +73,20 @@ def imu_values(orientation: Sequence[float]) -> tuple[float, float, float]:
     return (*roll_pitch(*orientation), yaw_of(*orientation))
 
 
-def controller_state_values(set_point: float, torque: float) -> tuple[float, float]:
-    """``controller/controller_state`` -> (set point [rad], torque [N m])."""
-    return set_point, torque
+def controller_state_values(set_point: float, torque: float,
+                            command_stamp: float) -> tuple[float, float, float]:
+    """
+    Return the planner's values of ``controller/controller_state``.
+
+    (set point [rad], torque [N m], stamp of the last swivel_command the controller heard
+    [s], -inf for none).
+    """
+    return set_point, torque, command_stamp
+
+
+def command_heard(tick: Tick) -> float:
+    """Return the stamp [s] of the last swivel_command the controller had heard at ``tick``."""
+    return tick.values[CONTROLLER_STATE][2]
 
 
 def observation(tick: Tick) -> Observation:
@@ -83,7 +94,7 @@ def observation(tick: Tick) -> Observation:
     x, y, yaw, speed = tick.values[ODOM]
     swivel, swivel_rate = tick.values[JOINT_STATES]
     roll, pitch, imu_yaw = tick.values[IMU]
-    set_point, torque = tick.values[CONTROLLER_STATE]
+    set_point, torque, _ = tick.values[CONTROLLER_STATE]
     return Observation(
         time=tick.time, x=x, y=y, yaw=yaw, swivel=swivel, swivel_rate=swivel_rate,
         set_point=set_point, torque=torque, roll=roll, pitch=pitch, imu_yaw=imu_yaw,
