@@ -8,14 +8,15 @@ the field, and nothing changes; a good one is accepted.
 from dataclasses import fields, replace
 import math
 
-from bad_values import assert_refusal_names, at_most, NON_FINITE, NOT_NUMERIC
-from hypothesis import assume, given, strategies as st
+from bad_values import assert_refusal_names, at_most, NON_FINITE, NOT_A_FINITE_NUMBER, NOT_NUMERIC
+from hypothesis import given, strategies as st
 import pytest
 from swivel_car_control.core.controller import ControllerConfig, SwivelController
 from swivel_car_control.core.joint_states import JointStateOdometry
 from swivel_car_control.core.limits import SlewLimiter
 from swivel_car_control.core.odometry_input import JointStateGate
 from swivel_car_control.core.pid import PidConfig, SwivelPid
+from swivel_car_control.core.steering import SteeringMap, tip_safe_swivel_limit
 from swivel_car_control.joints import JointReader
 from swivel_car_model.description import CarDescription
 
@@ -25,8 +26,6 @@ CONFIG_FIELDS = [item.name for item in fields(ControllerConfig)]
 MAY_BE_ZERO = ('cmd_vel_timeout', 'swivel_command_timeout', 'slowdown_start',
                'tip_over_margin', 'max_integral_torque')
 NAMES = ('swivel_joint', 'rear_left_wheel_joint', 'rear_right_wheel_joint')
-# A bool passes these cores as the number 0 or 1 (isinstance(True, int)): not drawn here.
-NOT_A_FINITE_NUMBER = NON_FINITE | NOT_NUMERIC
 GOOD_PID = {'kp': 1.0, 'ki': 1.0, 'kd': 1.0, 'max_torque': 1.0, 'max_integral_torque': 1.0}
 
 
@@ -98,8 +97,8 @@ def test_a_good_swivel_command_is_taken(angle, max_rate, drive, stamp):
 @given(name=st.sampled_from(list(GOOD_PID) + ['integral_band']),
        bad=NOT_A_FINITE_NUMBER | at_most(-1e-9))
 def test_pid_config_refuses_a_bad_field_naming_it(name, bad):
-    # inf: integrate at any error (the default); a str there is a TypeError (reported).
-    assume(name != 'integral_band' or (isinstance(bad, float) and bad != math.inf))
+    if name == 'integral_band' and bad == math.inf:
+        bad = 0.0  # inf: integrate at any error (the default)
     with pytest.raises(ValueError) as error:
         PidConfig(**{**GOOD_PID, name: bad})
     assert_refusal_names(error.value, name)
@@ -160,7 +159,7 @@ def test_a_slew_limiter_step_with_a_bad_dt_is_refused_and_keeps_its_value(bad, t
 
 
 @given(name=st.sampled_from(['publish_rate', 'yaw_rate_source']),
-       bad=NON_FINITE | at_most(0.0))
+       bad=NOT_A_FINITE_NUMBER | at_most(0.0))
 def test_joint_state_odometry_refuses_a_bad_setting_naming_it(name, bad):
     settings = {'publish_rate': 50.0, 'yaw_rate_source': 'swivel', name: bad}
     with pytest.raises(ValueError) as error:
@@ -185,6 +184,26 @@ def test_joint_state_gate_refuses_a_bad_max_gap(bad):
     with pytest.raises(ValueError) as error:
         JointStateGate(dict.fromkeys(NAMES, 100.0), max_gap=bad)
     assert_refusal_names(error.value, 'max_gap')
+
+
+@given(name=st.sampled_from(['swivel_limit', 'max_speed']),
+       bad=NOT_A_FINITE_NUMBER | at_most(0.0))
+def test_steering_map_refuses_a_bad_limit_naming_it(name, bad):
+    with pytest.raises(ValueError) as error:
+        SteeringMap(P, **{'swivel_limit': 1.0, 'max_speed': 0.5, name: bad})
+    assert_refusal_names(error.value, name)
+
+
+@given(bad=st.tuples(st.sampled_from(['swivel_limit', 'margin']),
+                     NOT_A_FINITE_NUMBER | at_most(-1e-9))
+       | st.floats(P.max_swivel_angle, 1e3, exclude_min=True).map(
+           lambda v: ('swivel_limit', v)))
+def test_tip_safe_swivel_limit_refuses_a_bad_argument_naming_it(bad):
+    name, value = bad
+    with pytest.raises(ValueError) as error:
+        tip_safe_swivel_limit(P, **{'swivel_limit': 1.0, 'margin': 0.1, name: value},
+                              samples=11)
+    assert_refusal_names(error.value, name)
 
 
 @given(joint=st.sampled_from(NAMES), bad=NON_FINITE)

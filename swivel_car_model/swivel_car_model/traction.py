@@ -33,14 +33,12 @@ from __future__ import annotations
 
 import math
 
+from swivel_car_model.checks import check_number
 from swivel_car_model.params import SwivelCarParams
 
 
 def _check(name: str, value: float, low: float = 0.0) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) \
-            or not math.isfinite(value) or value < low:
-        raise ValueError(f'{name} must be a finite number >= {low}, got {value!r}')
-    return float(value)
+    return check_number(name, value, at_least=low)
 
 
 def trailing_axle_min_com(p: SwivelCarParams, step_height: float, com_height: float,

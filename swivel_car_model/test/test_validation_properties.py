@@ -11,7 +11,7 @@ import math
 from bad_values import assert_refusal_names, at_most, NOT_A_FINITE_NUMBER
 from hypothesis import given, strategies as st
 import pytest
-from swivel_car_model.checks import check_finite_number
+from swivel_car_model.checks import check_finite_number, check_number
 from swivel_car_model.description import CarDescription
 from swivel_car_model.params import SwivelCarParams
 
@@ -32,6 +32,21 @@ def test_check_finite_number_refuses_naming_the_field(bad, name):
 @given(good=st.integers(-10**6, 10**6) | st.floats(allow_nan=False, allow_infinity=False))
 def test_check_finite_number_takes_any_finite_int_or_float(good):
     check_finite_number('mass', good)
+
+
+@given(bad=NOT_A_FINITE_NUMBER | at_most(0.0) | st.just(10**400),
+       bound=st.sampled_from([{'above': 0.0}, {'at_least': 1e-300}]))
+def test_check_number_refuses_a_bad_value_in_one_line_naming_the_field(bad, bound):
+    with pytest.raises(ValueError) as error:
+        check_number('publish_rate', bad, unit='Hz', **bound)
+    assert_refusal_names(error.value, 'publish_rate')
+    assert 'Hz, got' in str(error.value)
+
+
+@given(good=st.integers(1, 10**6) | st.floats(min_value=1e-300, allow_nan=False))
+def test_check_number_with_allow_inf_takes_inf_and_returns_a_float(good):
+    value = check_number('integral_band', good, above=0.0, allow_inf=True)
+    assert value == good and type(value) is float
 
 
 @given(name=st.sampled_from(PARAMS_FIELDS), bad=NOT_A_FINITE_NUMBER)

@@ -34,6 +34,7 @@ from rclpy.time import Time
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import Header
 from swivel_car_model import dynamics, kinematics
+from swivel_car_model.checks import check_number
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
@@ -205,10 +206,7 @@ class PlannerNode(Node):
     def _positive_parameter(self, name: str, default: float, description: str) -> float:
         value = self.declare_parameter(name, default, ParameterDescriptor(
             description=description, dynamic_typing=True, read_only=True)).value
-        if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                or not math.isfinite(value) or value <= 0.0:
-            raise ValueError(f'parameter {name} must be finite and > 0, got {value!r}')
-        return value
+        return check_number(f'parameter {name}', value, above=0.0)
 
     def _changed_config(self, parameters: list) -> PlannerConfig:
         """Return the climb settings with ``parameters`` set; ValueError names a bad one."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import signal
 from typing import Any, Callable, Collection, Mapping, TypeVar
 
 from builtin_interfaces.msg import Time
@@ -146,6 +147,18 @@ def run_node(node_class: type[Node], name: str, args: list[str] | None = None,
 
     Returns the process exit code (0, or 1 for a configuration error).
     """
+    signals: list[int] = []
+
+    def on_signal(signum: int, frame) -> None:
+        # rclpy's handlers pass the signal on to this one. A KeyboardInterrupt raised while
+        # the EventsExecutor hands a callback its argument reaches spin_once as pybind11's
+        # RuntimeError "Unable to convert call argument" (seen once in CI, on SIGINT).
+        signals.append(signum)
+        if signum == signal.SIGINT:
+            raise KeyboardInterrupt
+
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, on_signal)  # before rclpy.init, which chains to it
     rclpy.init(args=args)
     node = executor = None
     try:
@@ -160,8 +173,8 @@ def run_node(node_class: type[Node], name: str, args: list[str] | None = None,
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except Exception as error:
-        if not rclpy.ok():
-            pass  # SIGINT/SIGTERM shut the context under a callback: "context is invalid"
+        if signals or not rclpy.ok():
+            pass  # a signal landed inside a callback, or shut the context under one
         elif isinstance(error, (ValueError, ParameterException)):
             rclpy.logging.get_logger(name).fatal(f'bad configuration: {error}')
             return 1

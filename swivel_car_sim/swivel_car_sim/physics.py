@@ -36,6 +36,7 @@ import tempfile
 import numpy as np
 import pybullet
 
+from swivel_car_model.checks import check_number
 from swivel_car_model.description import CarDescription, ROBOT_VARIANTS
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_sim.urdf import build_robot, RobotModel
@@ -91,9 +92,11 @@ class SimConfig:
         if self.robot_variant not in ROBOT_VARIANTS:
             raise ValueError(
                 f'robot_variant must be one of {ROBOT_VARIANTS}, got {self.robot_variant!r}')
-        _require(0.0 < self.time_step <= 0.01, 'time_step', self.time_step, 'in (0, 0.01] s')
-        _require(self.ground_friction > 0.0, 'ground_friction', self.ground_friction, '> 0')
-        _require(self.watchdog_timeout >= 0.0, 'watchdog_timeout', self.watchdog_timeout, '>= 0')
+        check_number('time_step', self.time_step, above=0.0, unit='s')
+        if self.time_step > 0.01:
+            raise ValueError(f'time_step must be in (0, 0.01] s, got {self.time_step!r}')
+        check_number('ground_friction', self.ground_friction, above=0.0)
+        check_number('watchdog_timeout', self.watchdog_timeout, at_least=0.0, unit='s')
         if not isinstance(self.body_collision, bool):
             raise ValueError(f'body_collision must be a bool, got {self.body_collision!r}')
 
@@ -101,11 +104,6 @@ class SimConfig:
     def params(self) -> SwivelCarParams:
         """Return the model's parameter set of the robot (geometry, derived mass and inertia)."""
         return self.description.model_params()
-
-
-def _require(ok: bool, name: str, value, what: str) -> None:
-    if not isinstance(value, (int, float)) or not math.isfinite(value) or not ok:
-        raise ValueError(f'{name} must be finite and {what}, got {value!r}')
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,7 @@ from swivel_car_control.core.pid import PidConfig, PidOutput, SwivelPid
 from swivel_car_control.core.steering import (
     SteeringMap, swivel_is_tip_safe, tip_safe_swivel_limit)
 from swivel_car_model import planar
+from swivel_car_model.checks import check_number
 from swivel_car_model.params import SwivelCarParams
 
 SOURCE_CMD_VEL = 'cmd_vel'
@@ -78,16 +79,12 @@ class ControllerConfig:
                                        'slowdown_start', 'slowdown_stop')
 
     def __post_init__(self) -> None:
+        positive = ('max_torque', 'integral_band', 'max_swivel_rate', 'max_linear_velocity',
+                    'max_linear_acceleration', 'max_angular_velocity',
+                    'max_angular_acceleration')
         for field in fields(self):
-            value = getattr(self, field.name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0.0:
-                raise ValueError(f'{field.name} must be a finite number >= 0, got {value!r}')
-        for name in ('max_torque', 'integral_band', 'max_swivel_rate',
-                     'max_linear_velocity',
-                     'max_linear_acceleration', 'max_angular_velocity',
-                     'max_angular_acceleration'):
-            if getattr(self, name) <= 0.0:
-                raise ValueError(f'{name} must be > 0, got {getattr(self, name)!r}')
+            bound = {'above': 0.0} if field.name in positive else {'at_least': 0.0}
+            check_number(field.name, getattr(self, field.name), **bound)
         if not self.slowdown_start <= self.slowdown_stop <= math.pi / 2:
             raise ValueError(
                 'need 0 <= slowdown_start <= slowdown_stop <= pi/2, got '

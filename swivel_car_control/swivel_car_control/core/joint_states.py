@@ -13,6 +13,7 @@ from typing import Sequence
 
 from swivel_car_control.core.controller import ControlOutput, SwivelController
 from swivel_car_control.joints import JointReader, JointSample
+from swivel_car_model.checks import check_number
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_model.planar import OffsetTricycleOdometry
 
@@ -114,8 +115,7 @@ class JointStateOdometry:
         if yaw_rate_source not in YAW_RATE_SOURCES:
             raise ValueError(f'yaw_rate_source must be one of {YAW_RATE_SOURCES}, got '
                              f'{yaw_rate_source!r}')
-        if not (math.isfinite(publish_rate) and publish_rate > 0.0):
-            raise ValueError(f'publish_rate must be > 0 Hz, got {publish_rate!r}')
+        check_number('publish_rate', publish_rate, above=0.0, unit='Hz')
         self.car = car
         self.odometry = OffsetTricycleOdometry(car)
         self._names = (swivel_joint, rear_left_wheel_joint, rear_right_wheel_joint)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from swivel_car_model.checks import check_finite_number
+from swivel_car_model.checks import check_finite_number, check_number
 
 
 class SlewLimiter:
@@ -23,8 +23,8 @@ class SlewLimiter:
     """
 
     def __init__(self, max_value: float, max_rate: float, initial: float = 0.0) -> None:
-        _check_rate('max_value', max_value, above_zero=True)
-        _check_rate('max_rate', max_rate, above_zero=True)
+        check_number('max_value', max_value, above=0.0, allow_inf=True)
+        check_number('max_rate', max_rate, above=0.0, allow_inf=True)
         self.max_value = max_value
         self.max_rate = max_rate
         self.value = self._clamp('initial', initial)
@@ -48,19 +48,11 @@ class SlewLimiter:
         if dt < 0.0:
             raise ValueError(f'dt must be >= 0, got {dt!r}')
         if max_rate is not None:
-            _check_rate('max_rate', max_rate, above_zero=False)
+            check_number('max_rate', max_rate, at_least=0.0, allow_inf=True)
         rate = self.max_rate if max_rate is None else min(max_rate, self.max_rate)
         step = rate * dt if dt > 0.0 else 0.0
         self.value += max(-step, min(step, target - self.value))
         return self.value
-
-
-def _check_rate(name: str, value: float, above_zero: bool) -> None:
-    """Refuse anything but a number > 0 (``above_zero``) or >= 0; inf is allowed."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value) \
-            or value < 0.0 or (above_zero and value == 0.0):
-        bound = '> 0' if above_zero else '>= 0'
-        raise ValueError(f'{name} must be a number {bound}, got {value!r}')
 
 
 def steering_speed_scale(error: float, full_below: float, stop_above: float) -> float:

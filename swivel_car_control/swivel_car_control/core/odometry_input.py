@@ -22,6 +22,7 @@ import math
 from typing import Mapping, Sequence
 
 from swivel_car_control.core.joint_states import JointStateOdometry
+from swivel_car_model.checks import check_number
 
 # Longest gap between two joint_states that is integrated across; a driver at 10 Hz or more
 # never leaves one this long, a fake stamp does.
@@ -65,14 +66,10 @@ class JointStateGate:
     """
 
     def __init__(self, max_rates: Mapping[str, float], max_gap: float = MAX_GAP) -> None:
-        for name, limit in max_rates.items():
-            if not (isinstance(limit, (int, float)) and math.isfinite(limit) and limit > 0.0):
-                raise ValueError(f'the rate limit of {name!r} must be a finite number > 0 '
-                                 f'rad/s, got {limit!r}')
-        if not (isinstance(max_gap, (int, float)) and math.isfinite(max_gap) and max_gap > 0.0):
-            raise ValueError(f'max_gap must be a finite number > 0 s, got {max_gap!r}')
-        self.max_rates = dict(max_rates)
-        self.max_gap = float(max_gap)
+        self.max_rates = {name: check_number(f'the rate limit of {name!r}', limit, above=0.0,
+                                             unit='rad/s')
+                          for name, limit in max_rates.items()}
+        self.max_gap = check_number('max_gap', max_gap, above=0.0, unit='s')
         self.last_time: float | None = None  # [s] of the last message admitted
         self._jumped_to: float | None = None  # [s] stamp of a refused jump, to confirm
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
+from swivel_car_model.checks import check_number
+
 
 @dataclass(frozen=True)
 class PidConfig:
@@ -46,14 +48,10 @@ class PidConfig:
     integral_band: float = math.inf
 
     def __post_init__(self) -> None:
-        for name in ('kp', 'ki', 'kd', 'max_torque', 'max_integral_torque'):
-            value = getattr(self, name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0.0:
-                raise ValueError(f'{name} must be a finite number >= 0, got {value!r}')
-        if math.isnan(self.integral_band) or self.integral_band <= 0.0:
-            raise ValueError(f'integral_band must be > 0, got {self.integral_band!r}')
-        if self.max_torque <= 0.0:
-            raise ValueError(f'max_torque must be > 0, got {self.max_torque!r}')
+        for name in ('kp', 'ki', 'kd', 'max_integral_torque'):
+            check_number(name, getattr(self, name), at_least=0.0)
+        check_number('max_torque', self.max_torque, above=0.0)
+        check_number('integral_band', self.integral_band, above=0.0, allow_inf=True)
 
 
 @dataclass(frozen=True)

@@ -21,6 +21,7 @@ import math
 
 import numpy as np
 from swivel_car_model import kinematics, planar
+from swivel_car_model.checks import check_number
 from swivel_car_model.params import SwivelCarParams
 
 
@@ -38,11 +39,11 @@ def tip_safe_swivel_limit(p: SwivelCarParams, swivel_limit: float, margin: float
         Bad arguments, or not even theta2 = 0 satisfies the rule.
 
     """
-    if not (math.isfinite(swivel_limit) and 0.0 < swivel_limit <= p.max_swivel_angle):
+    check_number('swivel_limit', swivel_limit, above=0.0, unit='rad')
+    if swivel_limit > p.max_swivel_angle:
         raise ValueError(f'swivel_limit must be in (0, {p.max_swivel_angle!r}], '
                          f'got {swivel_limit!r}')
-    if not math.isfinite(margin) or margin < 0.0:
-        raise ValueError(f'margin must be finite and >= 0, got {margin!r}')
+    check_number('margin', margin, at_least=0.0, unit='rad')
     angles = np.linspace(0.0, swivel_limit, samples)
     ok = np.ones(samples, dtype=bool)
     for side in (1.0, -1.0):
@@ -97,8 +98,8 @@ class SteeringMap:
     """
 
     def __init__(self, p: SwivelCarParams, swivel_limit: float, max_speed: float) -> None:
-        if not (math.isfinite(max_speed) and max_speed > 0.0):
-            raise ValueError(f'max_speed must be > 0, got {max_speed!r}')
+        check_number('swivel_limit', swivel_limit, above=0.0, unit='rad')
+        check_number('max_speed', max_speed, above=0.0, unit='m/s')
         self.p = p
         self.swivel_limit = swivel_limit
         self.max_speed = max_speed

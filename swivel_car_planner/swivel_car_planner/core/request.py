@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-import math
 
+from swivel_car_model.checks import check_finite_number
 from swivel_car_planner.core.codes import ErrorCode
 from swivel_car_planner.core.config import PlannerConfig
 
@@ -46,9 +46,10 @@ def validate_request(request: ClimbRequest,
     """
     for name in ('step_height', 'step_distance', 'step_yaw', 'time_allowance', 'step_width',
                  'step_offset'):
-        value = getattr(request, name)
-        if not math.isfinite(value):
-            return ErrorCode.INVALID_REQUEST, f'{name} must be finite, got {value!r}'
+        try:
+            check_finite_number(name, getattr(request, name))
+        except ValueError as error:
+            return ErrorCode.INVALID_REQUEST, str(error)
     if request.step_height <= 0.0:
         return (ErrorCode.INVALID_REQUEST,
                 f'step_height must be > 0, got {request.step_height!r} m')
