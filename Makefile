@@ -35,13 +35,10 @@ build: setup
 # Test files run side by side, one pytest-xdist worker per core (PYTEST_WORKERS=0: in one
 # process); each worker claims its own block of ROS domain ids. A file stays on one worker
 # (module fixtures carry a stack from test to test), in the order pytest.ini lists them.
-# Then the files that still need the machine to themselves (root conftest.py). Exit code 5
-# is a selection (PYTEST_ARGS) with nothing in one of the two parts.
 test: build
 	@echo '== running every test'
 	$(IN_WS) python -m pytest -n $(PYTEST_WORKERS) --dist loadfile --no-loadscope-reorder \
-	    -m 'not alone' $(PYTEST_ARGS) || [ $$? -eq 5 ]
-	$(IN_WS) python -m pytest -m alone $(PYTEST_ARGS) || [ $$? -eq 5 ]
+	    $(PYTEST_ARGS)
 
 demo: build
 	@echo '== running the demo: the simulated car drives to a step and climbs it'

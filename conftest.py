@@ -23,18 +23,3 @@ for package in ('swivel_car_bringup', 'swivel_car_control', 'swivel_car_model',
 settings.register_profile('deterministic', derandomize=True)
 settings.register_profile('explore', derandomize=False)
 settings.load_profile(os.environ.get('HYPOTHESIS_PROFILE', 'deterministic'))
-
-
-# Files whose results still depend on the machine's load, so `make test` runs them alone after
-# the files run side by side (marked `alone`). The routes' odometry is outside the lockstep
-# chain of a sim paced at 6x and skips states when another worker takes its core (end error
-# 0.06-0.60 m against 0.05 m alone); this goes once the odometry and the route driver take part
-# in the chain.
-_ALONE = {'swivel_car_control/test/test_system_routes.py'}
-
-
-def pytest_collection_modifyitems(items) -> None:
-    """Mark the tests of the files in ``_ALONE``."""
-    for item in items:
-        if item.nodeid.split('::')[0] in _ALONE:
-            item.add_marker('alone')

@@ -125,20 +125,23 @@ def start_node(package: str, executable: str, domain_id: int,
 
 
 def lockstep_parameters(executable: str, lockstep_timeout: float,
-                        real_time_factor: float = 1.0) -> dict[str, Any]:
+                        real_time_factor: float = 1.0,
+                        cmd_vel_driver: bool = False) -> dict[str, Any]:
     """
     Return the parameters that put ``executable`` into the lockstep chain.
 
     The chain of docs/architecture.md: the sim waits for the controller's command of each state (at
     most ``lockstep_timeout`` wall seconds), the controller for the planner's command of the state
-    before. The sim is paced at ``real_time_factor`` (0: none) so that nodes outside the chain,
-    publishing cmd_vel, keep up.
+    before, and with ``cmd_vel_driver`` for a driver's cmd_vel stamped with it. The sim is paced
+    at ``real_time_factor`` (0: none) so that nodes outside the chain, publishing cmd_vel, keep
+    up.
     """
     if executable == 'sim_node':
         return {'lockstep': True, 'lockstep_timeout': lockstep_timeout,
                 'lockstep_real_time_factor': real_time_factor}
     if executable == 'controller_node':
-        return {'lockstep_swivel_command': True, 'lockstep_wait': lockstep_timeout / 2.0}
+        return {'lockstep_swivel_command': True, 'lockstep_cmd_vel': cmd_vel_driver,
+                'lockstep_wait': lockstep_timeout / 2.0}
     return {}
 
 

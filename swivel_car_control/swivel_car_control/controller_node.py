@@ -77,6 +77,12 @@ class ControllerNode(Node):
                             'answer each joint_states only once the command answering the '
                             'previous one has come, so climbs do not depend on machine '
                             'load', read_only=True)).value
+        self._lockstep_cmd_vel = self.declare_parameter(
+            'lockstep_cmd_vel', False, ParameterDescriptor(
+                description='lockstep sim with a driver that answers every state with a '
+                            'cmd_vel stamped with it (a test or benchmark driver): wait for '
+                            "that cmd_vel as for the planner's command; not for a teleop, "
+                            'which publishes at its own rate', read_only=True)).value
         self._lockstep_wait = self.declare_parameter(
             'lockstep_wait', 0.05, ParameterDescriptor(
                 description='longest wall-time wait for that command; then answer without '
@@ -99,6 +105,9 @@ class ControllerNode(Node):
         self._pending: JointState | None = None  # joint_states waiting for that command
         self._pending_since = 0.0  # [s] wall
         self._planner_late = False
+        self._heard_cmd_vel_stamp = TimeMsg()  # of the last stamped cmd_vel (zero: none)
+        self._cmd_vel_stamped = False  # the last cmd_vel came stamped: a driver in the chain
+        self._driver_late = False
 
         self._command_pub = self.create_publisher(ActuatorCommand, 'actuator_command', 10)
         self._state_pub = self.create_publisher(SwivelControllerState, '~/controller_state', 10)
@@ -108,7 +117,7 @@ class ControllerNode(Node):
                                  self._on_cmd_vel, 10)
         self.create_subscription(SwivelCommand, 'swivel_command', self._on_swivel_command, 10)
         self.create_subscription(Header, 'sim/reset_event', self._on_sim_reset, 10)
-        if self._lockstep_swivel_command:
+        if self._lockstep_swivel_command or self._lockstep_cmd_vel:
             self.create_timer(self._lockstep_wait / 4.0, self._on_wait_timer,
                               clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.get_logger().info(
@@ -116,7 +125,8 @@ class ControllerNode(Node):
             f'kp={car.kp} ki={car.ki} kd={car.kd}, cmd_vel as '
             f'{"TwistStamped" if self._use_stamped else "Twist"}, '
             f'deadman {config.cmd_vel_timeout} s'
-            + (', lockstep with swivel_command' if self._lockstep_swivel_command else ''))
+            + (', lockstep with swivel_command' if self._lockstep_swivel_command else '')
+            + (', lockstep with cmd_vel' if self._lockstep_cmd_vel else ''))
 
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9  # [s]
@@ -151,13 +161,19 @@ class ControllerNode(Node):
         if isinstance(msg, TwistStamped):
             twist = msg.twist
             stamp = self._cmd_vel_time(msg.header.stamp)
+            self._cmd_vel_stamped = not is_zero_stamp(msg.header.stamp)
+            if self._cmd_vel_stamped:  # even a refused one answers its cycle
+                self._heard_cmd_vel_stamp = msg.header.stamp
+                self._driver_late = False
         else:
             twist = msg
             stamp = self._now()
+            self._cmd_vel_stamped = False
         try:
             self._core.set_cmd_vel(twist.linear.x, twist.angular.z, stamp)
         except ValueError as error:
             self.get_logger().warn(str(error))
+        self._answer_pending()
 
     def _on_swivel_command(self, msg: SwivelCommand) -> None:
         held_before = self._core.swivel_command is not None
@@ -181,7 +197,10 @@ class ControllerNode(Node):
                     f'{msg.drive_speed:.3f} rad/s')
             elif held_before and not msg.hold:
                 self.get_logger().info('swivel_command released: cmd_vel steers again')
-        if self._pending is not None and not self._must_wait(self._pending):
+        self._answer_pending()
+
+    def _answer_pending(self) -> None:
+        if self._pending is not None and not self._awaited(self._pending):
             self._answer(self._take_pending())
 
     def _on_sim_reset(self, msg: Header) -> None:
@@ -195,23 +214,31 @@ class ControllerNode(Node):
         if self._pending is not None and stamp_to_seconds(self._pending.header.stamp) < t:
             self._pending = None  # a state of the old world: the sim waits for it no more
         self._heard_command_stamp = TimeMsg()
+        self._heard_cmd_vel_stamp = TimeMsg()
+        self._cmd_vel_stamped = False
         self.get_logger().info(f'the sim was reset at {t:.3f} s: commands dropped, the swivel '
                                'held where it is measured then, drive stopped, until a new '
                                'command')
 
-    def _must_wait(self, msg: JointState) -> bool:
+    def _awaited(self, msg: JointState) -> list[str]:
         """
-        Tell whether ``msg`` waits for the command that answers the previous joint_states.
+        List the commands ``msg`` waits for: those that answer the previous joint_states.
 
-        It does in lockstep with a stamped swivel_command held (the planner's pipeline is one
-        cycle deep).
+        In lockstep, a stamped swivel_command held (the planner's pipeline is one cycle deep)
+        and a stamped cmd_vel (a driver in the chain), each until it is late once.
         """
         last_time = self._joint_states.last_time  # [s] of the last joint_states answered
-        if (not self._lockstep_swivel_command or self._planner_late or last_time is None
-                or self._core.swivel_command is None or not self._held_stamped):
-            return False
-        return (stamp_to_seconds(msg.header.stamp) > last_time
-                > moment_seconds(self._heard_command_stamp))
+        if last_time is None or stamp_to_seconds(msg.header.stamp) <= last_time:
+            return []
+        awaited = []
+        if (self._lockstep_swivel_command and not self._planner_late
+                and self._core.swivel_command is not None and self._held_stamped
+                and last_time > moment_seconds(self._heard_command_stamp)):
+            awaited.append('swivel_command')
+        if (self._lockstep_cmd_vel and not self._driver_late and self._cmd_vel_stamped
+                and last_time > moment_seconds(self._heard_cmd_vel_stamp)):
+            awaited.append('cmd_vel')
+        return awaited
 
     def _take_pending(self) -> JointState:
         msg, self._pending = self._pending, None
@@ -220,15 +247,18 @@ class ControllerNode(Node):
     def _on_wait_timer(self) -> None:
         if (self._pending is not None
                 and time.monotonic() - self._pending_since > self._lockstep_wait):
-            self.get_logger().warn(
-                f'no swivel_command answered the last state within lockstep_wait '
-                f'{self._lockstep_wait} s: going on without it until the next command comes '
-                '(the climb is no longer deterministic)', throttle_duration_sec=5.0)
-            self._planner_late = True
+            awaited = self._awaited(self._pending)
+            if awaited:
+                self.get_logger().warn(
+                    f'no {" or ".join(awaited)} answered the last state within lockstep_wait '
+                    f'{self._lockstep_wait} s: going on without it until the next one comes '
+                    '(the run is no longer deterministic)', throttle_duration_sec=5.0)
+            self._planner_late = self._planner_late or 'swivel_command' in awaited
+            self._driver_late = self._driver_late or 'cmd_vel' in awaited
             self._answer(self._take_pending())
 
     def _on_joint_states(self, msg: JointState) -> None:
-        if self._must_wait(msg):
+        if self._awaited(msg):
             if self._pending is None or self._pending.header.stamp != msg.header.stamp:
                 self._pending_since = time.monotonic()
             self._pending = msg
@@ -274,6 +304,7 @@ class ControllerNode(Node):
         state.drive_speed = out.drive_speed
         state.source = out.source
         state.swivel_command_stamp = self._heard_command_stamp
+        state.cmd_vel_stamp = self._heard_cmd_vel_stamp
         self._state_pub.publish(state)
 
         limited = TwistStamped()

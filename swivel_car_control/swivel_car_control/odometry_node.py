@@ -24,7 +24,8 @@ from swivel_car_control.core.odometry_input import (
 from swivel_car_control.joints import MissingJointError
 from swivel_car_msgs.srv import SetPose2D
 from swivel_car_ros.ros_params import (
-    declare_dataclass, declare_description, live_parameters, run_node, stamp_to_seconds)
+    declare_dataclass, declare_description, live_parameters, run_node, stamp_to_seconds,
+    STATE_QUEUE_DEPTH)
 
 
 @dataclass(frozen=True)
@@ -119,7 +120,8 @@ class OdometryNode(Node):
         # Outside the lockstep chain the odometry may trail a busy sim: a second of states
         # queued, so it integrates every one instead of dropping them and Euler-stepping the
         # gap with the last rates.
-        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 100)
+        self.create_subscription(JointState, 'joint_states', self._on_joint_states,
+                                 STATE_QUEUE_DEPTH)
         self.create_service(Empty, '~/reset', self._on_reset)
         self.create_service(SetPose2D, '~/set_pose', self._on_set_pose)
 

@@ -286,6 +286,41 @@ def test_lockstep_waits_for_the_planners_command_of_the_previous_state():
         harness.close()
 
 
+def test_lockstep_cmd_vel_waits_for_the_drivers_cmd_vel_of_the_previous_state():
+    harness = Harness(ControllerNode, {'lockstep_cmd_vel': True, 'lockstep_wait': 3.0})
+    try:
+        commands = harness.record(ActuatorCommand, 'actuator_command')
+        harness.joints = harness.probe.create_publisher(JointState, 'joint_states', 10)
+        harness.cmd_vel = harness.probe.create_publisher(TwistStamped, 'cmd_vel', 10)
+        for publisher in (harness.joints, harness.cmd_vel):
+            harness.wait_connected(publisher)
+        spin_until(harness.executor, lambda: harness.probe.count_publishers('actuator_command'),
+                   10.0, 'publishers')
+
+        step(harness, 1.0)  # no driver yet: no wait
+        send_cmd_vel(harness, 0.2, 0.0, 1.0)  # a cmd_vel answering 1.0: the driver is chained
+        step(harness, 1.01)
+        harness.joints.publish(joint_state(1.02))
+        for _ in range(20):
+            harness.executor.spin_once(timeout_sec=0.01)
+        assert commands[-1].header.stamp == joint_state(1.01).header.stamp  # 1.02 waits
+        send_cmd_vel(harness, 0.2, 0.0, 1.01)
+        spin_until(harness.executor,
+                   lambda: commands[-1].header.stamp == joint_state(1.02).header.stamp, 10.0,
+                   'the answer to 1.02')
+
+        # An unstamped cmd_vel (a teleop's) leaves the chain: 1.03 is answered at once.
+        harness.cmd_vel.publish(TwistStamped())
+        for _ in range(20):
+            harness.executor.spin_once(timeout_sec=0.01)
+        harness.joints.publish(joint_state(1.03))
+        spin_until(harness.executor,
+                   lambda: commands[-1].header.stamp == joint_state(1.03).header.stamp, 1.5,
+                   'the answer to 1.03 well within lockstep_wait')
+    finally:
+        harness.close()
+
+
 @pytest.mark.parametrize('wait', [0.0, -1.0, math.nan])
 def test_bad_lockstep_wait_is_a_clear_error_at_start(wait):
     harness = None

@@ -5,11 +5,11 @@ The routes are ``swivel_car_control.benchmark.routes``; each executable is its o
 sim_node in lockstep, controller_node, odometry_node. The odometry's end pose is checked
 against the sim's ground truth, as the benchmark does in-process.
 
-The route driver acts once per controller state, like the planner: its swivel commands are
-stamped with the state they answer and the controller waits for them (the lockstep chain of
-docs/architecture.md), so the swivel routes are deterministic. Its cmd_vel segments are taken
-whenever they arrive, a few control periods late on a busy machine; that shifts the route a
-little, not the odometry's error against the truth of the same run.
+The route driver acts once per controller state, like the planner: its swivel commands and
+its cmd_vel are stamped with the state they answer and the controller waits for them (the
+lockstep chain of docs/architecture.md, with ``lockstep_cmd_vel``), so the routes are
+deterministic and the sim runs unpaced. The odometry, outside the chain, lags behind at
+times; it skips no state (the sim keeps 10 s of joint_states for it).
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ from swivel_car_control.test.test_system import _seconds, _yaw
 from swivel_car_model.description import CarDescription
 from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ResetSimulation
+from swivel_car_ros.ros_params import moment_seconds
 from swivel_car_testing import (
     lockstep_parameters, next_domain_id, spin_until, start_node)
 
@@ -52,7 +53,10 @@ class RouteDriver:
         self.truth: dict[float, Odometry] = {}  # by stamp [s]
         self.odom: dict[float, Odometry] = {}
         self.time = -1.0  # [s] stamp of the last controller state
+        # A route to start: its segments, and the stamp of its first command once sent [s].
+        self.start: tuple[list[Segment], float | None] | None = None
         self.plan: list[tuple[float, Segment]] = []  # (end time [s], segment)
+        self.end = 0.0  # [s] of the route started last
         self.cmd_vel = self.node.create_publisher(TwistStamped, 'cmd_vel', 10)
         self.swivel = self.node.create_publisher(SwivelCommand, 'swivel_command', 10)
         self.node.create_subscription(
@@ -67,21 +71,43 @@ class RouteDriver:
 
     def _on_state(self, msg: SwivelControllerState) -> None:
         self.time = _seconds(msg)
+        if self.start is not None:
+            segments, first = self.start
+            if first is None or moment_seconds(msg.cmd_vel_stamp) < first:
+                # Until the controller has heard the route's first command it does not wait
+                # for this driver, and the sim may run ahead: that command stands for each
+                # such moment, and the route starts from the first state that applies it.
+                self.start = (segments, self.time if first is None else first)
+                self._command(segments[0], msg.header)
+                return
+            self.start = None
+            self.end = self.time
+            for segment in segments:
+                self.end += segment.duration
+                self.plan.append((self.end, segment))
         while self.plan and self.time >= self.plan[0][0]:
             self.plan.pop(0)
             if not self.plan:
                 self.swivel.publish(SwivelCommand(header=msg.header, hold=False))
-        if not self.plan:
-            return
-        segment = self.plan[0][1]
+                self.cmd_vel.publish(TwistStamped())  # unstamped: out of the chain
+        if self.plan:
+            self._command(self.plan[0][1], msg.header)
+
+    def _command(self, segment: Segment, header) -> None:
+        """
+        Send the commands of ``segment`` answering the state of ``header``.
+
+        Both stamped, so that the controller waits for both (in a swivel segment the held
+        swivel_command sets the drive, and the cmd_vel only answers the state).
+        """
+        command = TwistStamped(header=header)
         if segment.kind == 'swivel':
-            self.swivel.publish(SwivelCommand(header=msg.header, angle=segment.a,
+            self.swivel.publish(SwivelCommand(header=header, angle=segment.a,
                                               drive_speed=segment.b, hold=True))
         else:
-            self.swivel.publish(SwivelCommand(header=msg.header, hold=False))
-            command = TwistStamped(header=msg.header)
+            self.swivel.publish(SwivelCommand(header=header, hold=False))
             command.twist.linear.x, command.twist.angular.z = segment.a, segment.b
-            self.cmd_vel.publish(command)
+        self.cmd_vel.publish(command)
 
     def call(self, client, request) -> None:
         spin_until(self.executor, client.service_is_ready, 60.0, client.srv_name)
@@ -90,15 +116,11 @@ class RouteDriver:
         assert getattr(future.result(), 'success', True), future.result()
 
     def run(self, segments: list[Segment]) -> float:
-        """Drive ``segments`` from the next controller state on; returns their end time."""
-        end = self.time
-        plan = []
-        for segment in segments:
-            end += segment.duration
-            plan.append((end, segment))
-        self.plan = plan
-        spin_until(self.executor, lambda: not self.plan, 600.0, 'the segments')
-        return end
+        """Drive ``segments`` from the next controller state on; returns their end time [s]."""
+        self.start = (segments, None)
+        spin_until(self.executor, lambda: self.start is None and not self.plan, 600.0,
+                   'the segments')
+        return self.end
 
     def wait(self, seconds: float, what: str) -> None:
         end = self.time + seconds
@@ -142,13 +164,9 @@ def driver():
     domain_id = next_domain_id()
     context = Context()
     rclpy.init(context=context, domain_id=domain_id)
-    # Paced at 6x (about what the chain reaches in swivel segments): in cmd_vel segments
-    # nothing holds the sim back, and running free it would flood this driver, whose commands
-    # then trail the sim (a 2.4 % turn on the spot was seen on a loaded machine); the deadman
-    # gets the slack of test_system.py for the same reason.
+    chain = {'real_time_factor': 0.0, 'cmd_vel_driver': True}
     processes = [start_node(package, executable, domain_id, {
-        'use_sim_time': True, **lockstep_parameters(executable, 2.0, real_time_factor=6.0),
-        **({'cmd_vel_timeout': 2.0} if executable == 'controller_node' else {})})
+        'use_sim_time': True, **lockstep_parameters(executable, 6.0, **chain)})
         for package, executable in (('swivel_car_sim', 'sim_node'),
                                     ('swivel_car_control', 'controller_node'),
                                     ('swivel_car_control', 'odometry_node'))]

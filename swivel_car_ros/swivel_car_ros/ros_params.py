@@ -25,6 +25,11 @@ from swivel_car_model.description import CarDescription
 
 T = TypeVar('T')
 
+# joint_states kept on both ends (publisher history, subscription queue), so that a node outside
+# the lockstep chain (the odometry) that lags behind an unpaced sim skips no state: 10 s of the
+# default control period.
+STATE_QUEUE_DEPTH = 1000
+
 
 def stamp_to_seconds(stamp: Time) -> float:
     """Convert a builtin_interfaces/Time to seconds [s]."""

@@ -21,7 +21,7 @@ from std_srvs.srv import SetBool
 from swivel_car_msgs.msg import ActuatorCommand
 from swivel_car_msgs.srv import (RemoveObstacle, ResetSimulation, SpawnObstacle,
                                  StepSimulation)
-from swivel_car_ros.ros_params import run_node
+from swivel_car_ros.ros_params import run_node, STATE_QUEUE_DEPTH
 from swivel_car_sim.config import PARAMETERS, SimNodeConfig
 from swivel_car_sim.conversions import sim_time_msg, StateMessages
 from swivel_car_sim.physics import MAX_STEPS_PER_CALL, StepSpec, SwivelCarSim
@@ -62,7 +62,7 @@ class SimNode(Node):
         self._reset_ns = 0  # [ns] sim time of the first state after the last ~/reset
 
         self._clock_pub = self.create_publisher(ClockMsg, '/clock', 10)
-        self._joint_pub = self.create_publisher(JointState, 'joint_states', 10)
+        self._joint_pub = self.create_publisher(JointState, 'joint_states', STATE_QUEUE_DEPTH)
         self._imu_pub = self.create_publisher(Imu, 'imu', 10)
         self._odom_pub = self.create_publisher(Odometry, 'ground_truth/odom', 10)
         self._reset_pub = self.create_publisher(Header, '~/reset_event', 10)
