@@ -9,7 +9,7 @@ The route driver acts once per controller state, like the planner: its swivel co
 its cmd_vel are stamped with the state they answer and the controller waits for them (the
 lockstep chain of docs/architecture.md, with ``lockstep_cmd_vel``), so the routes are
 deterministic and the sim runs unpaced. The odometry, outside the chain, lags behind at
-times; it skips no state (the sim keeps 10 s of joint_states for it).
+times; it skips no state (the sim keeps 1 s of joint_states for it).
 """
 
 from __future__ import annotations

@@ -26,9 +26,10 @@ from swivel_car_model.description import CarDescription
 T = TypeVar('T')
 
 # joint_states kept on both ends (publisher history, subscription queue), so that a node outside
-# the lockstep chain (the odometry) that lags behind an unpaced sim skips no state: 10 s of the
-# default control period.
-STATE_QUEUE_DEPTH = 1000
+# the lockstep chain (the odometry) that lags behind an unpaced sim skips no state: 1 s of the
+# default control period. With 10 s, one full test run had whole-stack tests stall on service
+# calls (cause not found; Fast DDS keeps a writer's history in a 512 KiB shared-memory segment).
+STATE_QUEUE_DEPTH = 100
 
 
 def stamp_to_seconds(stamp: Time) -> float:
