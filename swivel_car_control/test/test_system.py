@@ -113,10 +113,12 @@ def stack():
     processes = [
         NodeProcess('swivel_car_sim', 'sim_node', domain_id,
                     {'lockstep': True, 'lockstep_timeout': 5.0}),
-        # The driver below is not part of the lockstep loop: on a loaded machine its commands
-        # trail the sim by some periods, so the deadman gets more slack than the default.
+        # The driver below answers every state with its cmd_vel, and the controller waits for
+        # it (lockstep_cmd_vel): the odometry, outside that chain, cannot fall far behind. Its
+        # first commands come before the chain holds, so the deadman keeps some slack.
         NodeProcess('swivel_car_control', 'controller_node', domain_id,
-                    {'use_sim_time': True, 'cmd_vel_timeout': DEADMAN},
+                    {'use_sim_time': True, 'cmd_vel_timeout': DEADMAN,
+                     'lockstep_cmd_vel': True, 'lockstep_wait': 1.0},
                     params_file=config_path('swivel_car_control', 'controller_node.yaml')),
         NodeProcess('swivel_car_control', 'odometry_node', domain_id, {'use_sim_time': True},
                     params_file=config_path('swivel_car_control', 'odometry_node.yaml')),
