@@ -7,6 +7,7 @@ One ActuatorCommand per joint_states message (the lockstep protocol of docs/arch
 from __future__ import annotations
 
 import dataclasses
+from dataclasses import dataclass, field
 import math
 import sys
 import time
@@ -28,6 +29,32 @@ from swivel_car_ros.ros_params import (
 
 # A cmd_vel stamped further than this ahead of the node clock is taken as arriving now.
 _CLOCK_SLACK = 0.5  # [s]
+
+
+@dataclass
+class _ChainedSource:
+    """A command stream the controller waits for in lockstep (docs/architecture.md)."""
+
+    name: str  # its topic
+    enabled: bool  # the lockstep_* parameter
+    heard: TimeMsg = field(default_factory=TimeMsg)  # its last stamped command (zero: none)
+    chained: bool = False  # the command in force came stamped: it takes part in the chain
+    late: bool = False  # missed a wait: not waited for until its next stamped command
+
+    def hear(self, stamp: TimeMsg) -> None:
+        """Take a command's stamp; a stamped one answers its cycle, refused or not."""
+        if not is_zero_stamp(stamp):
+            self.heard, self.late = stamp, False
+
+    def awaited(self, last_time: float) -> bool:
+        """Tell whether its answer to the state of ``last_time`` [s] is still to come."""
+        return (self.enabled and self.chained and not self.late
+                and last_time > moment_seconds(self.heard))
+
+    def forget(self) -> None:
+        """Drop what was heard: a sim reset's new world."""
+        self.heard, self.chained = TimeMsg(), False
+
 
 CONFIG_DESCRIPTIONS = {
     'max_integral_torque': 'clamp on the PID integral contribution [N m]',
@@ -99,15 +126,10 @@ class ControllerNode(Node):
                         self._core.reconfigure)
         self._joint_states = JointStateController(self._core, swivel_joint)
         self._warned_zero_stamp = False
-        self._heard_command_stamp = TimeMsg()  # of the last stamped swivel_command (zero: none)
-        self._held_stamped = False  # the held swivel_command came stamped: it takes part in
-        # the lockstep
-        self._pending: JointState | None = None  # joint_states waiting for that command
+        self._planner = _ChainedSource('swivel_command', self._lockstep_swivel_command)
+        self._driver = _ChainedSource('cmd_vel', self._lockstep_cmd_vel)
+        self._pending: JointState | None = None  # joint_states waiting for their commands
         self._pending_since = 0.0  # [s] wall
-        self._planner_late = False
-        self._heard_cmd_vel_stamp = TimeMsg()  # of the last stamped cmd_vel (zero: none)
-        self._cmd_vel_stamped = False  # the last cmd_vel came stamped: a driver in the chain
-        self._driver_late = False
 
         self._command_pub = self.create_publisher(ActuatorCommand, 'actuator_command', 10)
         self._state_pub = self.create_publisher(SwivelControllerState, '~/controller_state', 10)
@@ -161,14 +183,12 @@ class ControllerNode(Node):
         if isinstance(msg, TwistStamped):
             twist = msg.twist
             stamp = self._cmd_vel_time(msg.header.stamp)
-            self._cmd_vel_stamped = not is_zero_stamp(msg.header.stamp)
-            if self._cmd_vel_stamped:  # even a refused one answers its cycle
-                self._heard_cmd_vel_stamp = msg.header.stamp
-                self._driver_late = False
+            self._driver.hear(msg.header.stamp)
+            self._driver.chained = not is_zero_stamp(msg.header.stamp)
         else:
             twist = msg
             stamp = self._now()
-            self._cmd_vel_stamped = False
+            self._driver.chained = False
         try:
             self._core.set_cmd_vel(twist.linear.x, twist.angular.z, stamp)
         except ValueError as error:
@@ -177,11 +197,7 @@ class ControllerNode(Node):
 
     def _on_swivel_command(self, msg: SwivelCommand) -> None:
         held_before = self._core.swivel_command is not None
-        stamped = not is_zero_stamp(msg.header.stamp)
-        if stamped:
-            # Even a refused command answers its cycle: the lockstep wait is over.
-            self._heard_command_stamp = msg.header.stamp
-            self._planner_late = False
+        self._planner.hear(msg.header.stamp)
         try:
             # The deadman counts from receipt: a planner that lags behind a lockstep sim
             # running ahead of it (before its first command held the sim back) is not dead.
@@ -190,7 +206,7 @@ class ControllerNode(Node):
         except ValueError as error:
             self.get_logger().error(str(error), throttle_duration_sec=1.0)
         else:
-            self._held_stamped = stamped
+            self._planner.chained = not is_zero_stamp(msg.header.stamp)
             if msg.hold and not held_before:
                 self.get_logger().info(
                     f'swivel_command takes over: angle {msg.angle:.3f} rad, drive '
@@ -213,16 +229,15 @@ class ControllerNode(Node):
             return
         if self._pending is not None and stamp_to_seconds(self._pending.header.stamp) < t:
             self._pending = None  # a state of the old world: the sim waits for it no more
-        self._heard_command_stamp = TimeMsg()
-        self._heard_cmd_vel_stamp = TimeMsg()
-        self._cmd_vel_stamped = False
+        self._planner.forget()
+        self._driver.forget()
         self.get_logger().info(f'the sim was reset at {t:.3f} s: commands dropped, the swivel '
                                'held where it is measured then, drive stopped, until a new '
                                'command')
 
-    def _awaited(self, msg: JointState) -> list[str]:
+    def _awaited(self, msg: JointState) -> list[_ChainedSource]:
         """
-        List the commands ``msg`` waits for: those that answer the previous joint_states.
+        List the sources whose commands ``msg`` waits for: answers to the previous state.
 
         In lockstep, a stamped swivel_command held (the planner's pipeline is one cycle deep)
         and a stamped cmd_vel (a driver in the chain), each until it is late once.
@@ -230,15 +245,10 @@ class ControllerNode(Node):
         last_time = self._joint_states.last_time  # [s] of the last joint_states answered
         if last_time is None or stamp_to_seconds(msg.header.stamp) <= last_time:
             return []
-        awaited = []
-        if (self._lockstep_swivel_command and not self._planner_late
-                and self._core.swivel_command is not None and self._held_stamped
-                and last_time > moment_seconds(self._heard_command_stamp)):
-            awaited.append('swivel_command')
-        if (self._lockstep_cmd_vel and not self._driver_late and self._cmd_vel_stamped
-                and last_time > moment_seconds(self._heard_cmd_vel_stamp)):
-            awaited.append('cmd_vel')
-        return awaited
+        sources = [self._driver]
+        if self._core.swivel_command is not None:  # released or timed out: nothing to wait for
+            sources.insert(0, self._planner)
+        return [source for source in sources if source.awaited(last_time)]
 
     def _take_pending(self) -> JointState:
         msg, self._pending = self._pending, None
@@ -249,12 +259,13 @@ class ControllerNode(Node):
                 and time.monotonic() - self._pending_since > self._lockstep_wait):
             awaited = self._awaited(self._pending)
             if awaited:
+                names = ' or '.join(source.name for source in awaited)
                 self.get_logger().warn(
-                    f'no {" or ".join(awaited)} answered the last state within lockstep_wait '
+                    f'no {names} answered the last state within lockstep_wait '
                     f'{self._lockstep_wait} s: going on without it until the next one comes '
                     '(the run is no longer deterministic)', throttle_duration_sec=5.0)
-            self._planner_late = self._planner_late or 'swivel_command' in awaited
-            self._driver_late = self._driver_late or 'cmd_vel' in awaited
+            for source in awaited:
+                source.late = True
             self._answer(self._take_pending())
 
     def _on_joint_states(self, msg: JointState) -> None:
@@ -303,8 +314,8 @@ class ControllerNode(Node):
         state.saturated = out.pid.saturated
         state.drive_speed = out.drive_speed
         state.source = out.source
-        state.swivel_command_stamp = self._heard_command_stamp
-        state.cmd_vel_stamp = self._heard_cmd_vel_stamp
+        state.swivel_command_stamp = self._planner.heard
+        state.cmd_vel_stamp = self._driver.heard
         self._state_pub.publish(state)
 
         limited = TwistStamped()
