@@ -27,6 +27,7 @@ CASES = [
     ('swivel_car_sim', 'sim_node', 'body_mass', 'heavy'),
     ('swivel_car_sim', 'sim_node', 'time_step', '-1.0'),
     ('swivel_car_control', 'controller_node', 'lockstep_wait', 'long'),
+    ('swivel_car_control', 'controller_node', 'lockstep_cmd_vel', 'maybe'),
     ('swivel_car_control', 'controller_node', 'kp', '.nan'),
     ('swivel_car_planner', 'planner_node', 'body_mass', '-1.0'),
     ('swivel_car_planner', 'planner_node', 'ready_timeout', '-1.0'),

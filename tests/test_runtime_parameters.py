@@ -41,6 +41,7 @@ def set_one(node, name, value):
     (SimNode, 'body_mass', math.nan), (SimNode, 'lockstep', True),
     (ControllerNode, 'max_linear_velocity', 1.0), (ControllerNode, 'body_mass', 3.0),
     (ControllerNode, 'use_stamped', False), (ControllerNode, 'lockstep_wait', 0.1),
+    (ControllerNode, 'lockstep_cmd_vel', True),
     (OdometryNode, 'publish_rate', 50.0), (OdometryNode, 'yaw_rate_source', 'rear_wheels'),
     (PlannerNode, 'body_mass', -1.0), (PlannerNode, 'ready_timeout', 3.0),
     (PlannerNode, 'capability_file', 'none')])
