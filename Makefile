@@ -7,6 +7,8 @@ STAMP := $(VENV)/.requirements-installed
 IN_WS := scripts/in_ws
 PYTEST_ARGS ?=
 PYTEST_WORKERS ?= auto
+# The nodes are Python: the messages' C++ interfaces are built only on request (MSGS_CPP=ON).
+MSGS_CPP ?= OFF
 
 .PHONY: setup build test demo figures bench soak clean
 
@@ -30,7 +32,7 @@ build: setup
 	@# A file removed from a package leaves a dangling symlink that fails the symlink install.
 	-find ros2_ws/build ros2_ws/install -xtype l -delete 2>/dev/null
 	cd ros2_ws && ../$(IN_WS) colcon build --symlink-install --event-handlers console_cohesion- summary+ \
-	    --cmake-args -DBUILD_TESTING=OFF
+	    --cmake-args -DBUILD_TESTING=OFF -DSWIVEL_CAR_MSGS_CPP=$(MSGS_CPP)
 
 # Test files run side by side, one pytest-xdist worker per core (PYTEST_WORKERS=0: in one
 # process); each worker claims its own block of ROS domain ids. A file stays on one worker
