@@ -34,7 +34,7 @@ from swivel_car_msgs.msg import StepObstacle
 from swivel_car_msgs.srv import SpawnObstacle
 from swivel_car_planner.core import capability
 from swivel_car_ros.ros_params import stamp_to_seconds
-from swivel_car_sim.physics import StepSpec
+from swivel_car_sim.world import StepSpec
 from swivel_car_stack import (
     lockstep_parameters, NodeProcess, REPO_ROOT, spin_until, start_node)
 

@@ -15,7 +15,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from rosbags.highlevel import AnyReader
 from swivel_car_model.params import SwivelCarParams
-from swivel_car_sim.physics import SimConfig, StepSpec, SwivelCarSim
+from swivel_car_sim.physics import SimConfig, SwivelCarSim
+from swivel_car_sim.world import StepSpec
 
 matplotlib.use('Agg')
 

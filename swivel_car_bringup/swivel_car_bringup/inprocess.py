@@ -49,7 +49,8 @@ from swivel_car_planner.core import (
 from swivel_car_planner.core.sync import InputSync
 from swivel_car_planner.ground_truth import GroundTruth
 from swivel_car_sim.config import PARAMETERS as SIM_PARAMETERS, SimNodeConfig
-from swivel_car_sim.physics import StepSpec, SwivelCarSim
+from swivel_car_sim.physics import SwivelCarSim
+from swivel_car_sim.world import StepSpec
 import yaml
 
 ROBOT_VARIANTS = ('swivel', 'car_like')

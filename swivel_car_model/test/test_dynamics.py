@@ -9,6 +9,7 @@ import pytest
 from swivel_car_model import dynamics as d
 from swivel_car_model import kinematics as k
 from swivel_car_model import planar
+from swivel_car_model.dynamics import car_like
 from swivel_car_model.params import SwivelCarParams
 
 P = SwivelCarParams()
@@ -101,10 +102,10 @@ def test_climb_bad_input(step):
 def test_car_like_climb_work_is_potential_plus_kinetic_energy():
     c = d.CarLikeParams(step_height=0.012)
     run = d.simulate_car_like_climb(c)
-    _, y0, *_ = d._crank_geometry(c, np.array(run.crank_angle[0]))
-    _, y1, *_ = d._crank_geometry(c, np.array(run.crank_angle[-1]))
+    _, y0, *_ = car_like._crank_geometry(c, np.array(run.crank_angle[0]))
+    _, y1, *_ = car_like._crank_geometry(c, np.array(run.crank_angle[-1]))
     rate = np.gradient(run.crank_angle, run.time)[-1]
-    inertia, _ = d._crank_profile(c)[1](run.crank_angle[-1])
+    inertia, _ = car_like._crank_profile(c)[1](run.crank_angle[-1])
     expected = c.mass * d.GRAVITY * (y1 - y0) + 0.5 * inertia * rate ** 2
     assert run.total_energy == pytest.approx(float(expected), rel=1e-2)
     assert run.peak_torque == pytest.approx(

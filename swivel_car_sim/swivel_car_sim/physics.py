@@ -3,27 +3,9 @@ The simulated swivel car: a pybullet world with the robot, its drive train and s
 
 ROS-free. ``SwivelCarSim`` owns one pybullet client (DIRECT unless ``gui``), steps it at a
 fixed ``time_step`` and exposes what a motor driver board and an IMU would: joint states, base
-orientation, angular velocity and specific force, plus the ground truth pose and twist.
-
-Drive train (one motor, a differential per axle, front and rear carriers coupled rigidly).
-pybullet's gear constraints couple two joints, not the three bodies of a differential, so the
-torques are computed every physics step and applied with TORQUE_CONTROL:
-
-* the motor is speed controlled with a torque limit: a PI loop on the rear carrier speed
-  (mean of the two rear wheel speeds, the motor's shaft through the rear differential),
-  ``T_m = sat(K_p e + K_i integral(e))``, the integral frozen while saturated;
-* the shaft to the front differential is stiff but not infinitely so (explicit torques in a
-  0.002 s step cannot be): a torsional spring-damper between the rear and front carrier angles,
-  ``T_f = K_s (theta_r - theta_f) + K_d (omega_r - omega_f)``, so the carrier speeds stay equal
-  on average and the wind-up stays small (about 0.06 rad at 10 N m);
-* an open differential gives both wheels of its axle half the axle's torque (front ``T_f``,
-  rear ``T_m - T_f``), their speeds free to differ; a locked one adds the same kind of
-  spring-damper between its two wheel angles, ``T_c = K_w (theta_a - theta_b) + D_w (omega_a
-  - omega_b)`` taken from wheel a and given to wheel b, so a wheel that loses its grip cannot
-  spin away while the other one stands (the torque goes where the traction is).
-
-The gains follow from the wheel inertia and the time step so that the worst case, an axle with
-both wheels in the air, is still well damped; their values are in ``DriveGains``.
+orientation, angular velocity and specific force, plus the ground truth pose and twist. The
+drive train's torques (``swivel_car_sim.drive_train``) are applied every physics step with
+TORQUE_CONTROL; the step obstacles are ``swivel_car_sim.world``'s.
 """
 
 from __future__ import annotations
@@ -39,7 +21,10 @@ import pybullet
 from swivel_car_model.checks import check_number
 from swivel_car_model.description import CarDescription, ROBOT_VARIANTS
 from swivel_car_model.params import SwivelCarParams
+from swivel_car_sim.drive_train import DriveTrain
+from swivel_car_sim.robot_state import RobotState
 from swivel_car_sim.urdf import build_robot, RobotModel
+from swivel_car_sim.world import BoundClient, Obstacles, StepSpec
 
 GRAVITY = 9.81  # [m/s^2]
 MAX_STEPS_PER_CALL = 100_000
@@ -106,132 +91,6 @@ class SimConfig:
         return self.description.model_params()
 
 
-@dataclass(frozen=True)
-class DriveGains:
-    """
-    Gains of the drive train model (see the module docstring).
-
-    Attributes
-    ----------
-    speed_p : float  # [N m s/rad]
-    speed_i : float  # [N m/rad]
-    shaft_stiffness : float  # [N m/rad]
-    shaft_damping : float  # [N m s/rad]
-    lock_stiffness : float  # [N m/rad] between the wheels of a locked axle
-    lock_damping : float  # [N m s/rad]
-
-    """
-
-    speed_p: float
-    speed_i: float
-    shaft_stiffness: float
-    shaft_damping: float
-    lock_stiffness: float
-    lock_damping: float
-
-    @classmethod
-    def for_robot(cls, params: SwivelCarParams, time_step: float) -> 'DriveGains':
-        """
-        Make the drive gains for a robot.
-
-        They keep a carrier with both wheels in the air (inertia 2 I_w) stable and well
-        damped, and give the loaded speed loop (the whole car on the rear carrier) a damping
-        ratio near 0.7.
-        """
-        wheel_inertia = params.wheel_mass * params.r ** 2 / 2.0  # [kg m^2] about the axle
-        free_carrier = 2.0 * wheel_inertia
-        loaded_carrier = params.mass * params.r ** 2 + 4.0 * wheel_inertia
-        speed_p = free_carrier / time_step  # dead-beat for the free carrier
-        speed_i = (speed_p / (2.0 * 0.7)) ** 2 / loaded_carrier
-        stiffness = 0.25 * free_carrier / time_step ** 2
-        damping = 2.0 * 0.7 * math.sqrt(stiffness * free_carrier)
-        # The two wheels of an axle twist against each other with the reduced inertia
-        # I_w / 2 (free in the air, the worst case): the same stiffness per time step.
-        relative = wheel_inertia / 2.0
-        lock_stiffness = 0.25 * relative / time_step ** 2
-        lock_damping = 2.0 * 0.7 * math.sqrt(lock_stiffness * relative)
-        return cls(speed_p, speed_i, stiffness, damping, lock_stiffness, lock_damping)
-
-
-@dataclass(frozen=True)
-class StepSpec:
-    """
-    A rectangular step, relative to base_link at the time of the request.
-
-    See swivel_car_msgs/msg/StepObstacle.msg for the meaning of each field.
-    """
-
-    name: str
-    height: float  # [m]
-    depth: float  # [m]
-    width: float  # [m]
-    distance: float  # [m]
-    yaw: float  # [rad]
-    friction: float  # [1]
-
-    def validate(self) -> None:
-        """Raise ValueError naming the first bad field."""
-        for name in ('height', 'depth', 'width', 'distance', 'yaw', 'friction'):
-            value = getattr(self, name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise ValueError(f'{name} must be finite, got {value!r}')
-        if not 0.0 < self.height <= 1.0:
-            raise ValueError(f'height must be in (0, 1] m, got {self.height!r}')
-        for name in ('depth', 'width'):
-            if not 0.0 < getattr(self, name) <= 20.0:
-                raise ValueError(f'{name} must be in (0, 20] m, got {getattr(self, name)!r}')
-        if self.distance < 0.0:
-            raise ValueError(f'distance must be >= 0 m, got {self.distance!r}')
-        if not -math.pi / 2.0 < self.yaw < math.pi / 2.0:
-            raise ValueError(f'yaw must be in (-pi/2, pi/2) rad, got {self.yaw!r}')
-        if not 0.0 < self.friction <= 10.0:
-            raise ValueError(f'friction must be in (0, 10], got {self.friction!r}')
-
-
-@dataclass(frozen=True)
-class RobotState:
-    """
-    What the sensors and the ground truth report at one instant.
-
-    Attributes
-    ----------
-    time : float  # [s] sim time
-    joint_names : tuple of str  # steer joint, then the four wheel joints
-    positions : numpy.ndarray  # [rad]
-    velocities : numpy.ndarray  # [rad/s]
-    efforts : numpy.ndarray  # [N m] torques applied during the last step
-    position : numpy.ndarray  # [m] base_link origin in the world
-    orientation : numpy.ndarray  # [1] base_link orientation, quaternion x, y, z, w
-    linear_velocity : numpy.ndarray  # [m/s] base_link origin velocity, in base_link
-    angular_velocity : numpy.ndarray  # [rad/s] in base_link
-    linear_acceleration : numpy.ndarray  # [m/s^2] specific force (IMU), in base_link
-
-    """
-
-    time: float
-    joint_names: tuple[str, ...]
-    positions: np.ndarray
-    velocities: np.ndarray
-    efforts: np.ndarray
-    position: np.ndarray
-    orientation: np.ndarray
-    linear_velocity: np.ndarray
-    angular_velocity: np.ndarray
-    linear_acceleration: np.ndarray
-
-    @property
-    def yaw(self) -> float:
-        """Heading of base_link about the world z axis [rad]."""
-        x, y, z, w = self.orientation
-        return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-    @property
-    def pitch(self) -> float:
-        """Pitch of base_link, positive nose down (REP-103 rotation about y) [rad]."""
-        x, y, z, w = self.orientation
-        return math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-
-
 class SwivelCarSim:
     """
     A pybullet world holding one swivel car (or car-like baseline) and step obstacles.
@@ -256,18 +115,15 @@ class SwivelCarSim:
         self.params = self.config.params
         self.robot: RobotModel = build_robot(self.description, self.config.robot_variant,
                                              body_collision=self.config.body_collision)
-        self.gains = DriveGains.for_robot(self.params, self.config.time_step)
-        self._rear_locked = self.description.rear_differential == 'locked'
-        self._front_locked = self.description.front_differential == 'locked'
+        self._drive_train = DriveTrain(self.description, self.config.time_step)
         # Read every physics step (_apply_actuators).
         self._time_step = self.config.time_step  # [s]
         self._watchdog_timeout = self.config.watchdog_timeout  # [s]
-        self._drive_torque_limit = self.description.drive_torque_limit  # [N m]
         self._client = pybullet.connect(pybullet.GUI if self.config.gui else pybullet.DIRECT)
         if self._client < 0:
             raise RuntimeError('pybullet could not connect' + (' a GUI (is there a display?)'
                                                                if self.config.gui else ''))
-        self._pb = _Client(self._client)
+        self._pb = BoundClient(self._client)
         self._pb.setPhysicsEngineParameter(fixedTimeStep=self.config.time_step,
                                            enableFileCaching=0, deterministicOverlappingPairs=1)
         self._pb.setGravity(0.0, 0.0, -GRAVITY)
@@ -278,8 +134,7 @@ class SwivelCarSim:
         with os.fdopen(fd, 'w') as f:
             f.write(self.robot.urdf)
         self._steps = 0
-        self._obstacles: dict[str, int] = {}
-        self._obstacle_counter = 0
+        self._obstacles = Obstacles(self._pb)
         self._body = -1
         self._load_robot(*initial_pose)
 
@@ -352,33 +207,11 @@ class SwivelCarSim:
                                        for start, end in zip(v_start, v_end)])
 
     def _apply_actuators(self) -> None:
-        # The hot loop (every physics step): plain floats, direct pybullet calls and the
-        # constants looked up once, since numpy on four numbers costs more than the physics
-        # step itself.
-        g = self.gains
-        dt = self._time_step
+        # The hot loop (every physics step): direct pybullet calls, no numpy.
         rl, rr, fl, fr = pybullet.getJointStates(self._body, self._wheel_ids,
                                                  physicsClientId=self._client)
-        if self.watchdog_tripped:
-            swivel_torque, drive_speed = 0.0, 0.0
-        else:
-            swivel_torque, drive_speed = self._swivel_torque, self._drive_speed
-        rear_speed, front_speed = (rl[1] + rr[1]) / 2.0, (fl[1] + fr[1]) / 2.0
-        error = drive_speed - rear_speed
-        limit = self._drive_torque_limit
-        unsaturated = g.speed_p * error + g.speed_i * (self._speed_integral + error * dt)
-        motor = min(limit, max(-limit, unsaturated))
-        if motor == unsaturated:
-            self._speed_integral += error * dt
-        front = (g.shaft_stiffness * ((rl[0] + rr[0]) - (fl[0] + fr[0])) / 2.0
-                 + g.shaft_damping * (rear_speed - front_speed))
-        rear = motor - front
-        rear_lock = (g.lock_stiffness * (rl[0] - rr[0]) + g.lock_damping * (rl[1] - rr[1])
-                     if self._rear_locked else 0.0)
-        front_lock = (g.lock_stiffness * (fl[0] - fr[0]) + g.lock_damping * (fl[1] - fr[1])
-                      if self._front_locked else 0.0)
-        self._efforts = [swivel_torque, rear / 2.0 - rear_lock, rear / 2.0 + rear_lock,
-                         front / 2.0 - front_lock, front / 2.0 + front_lock]
+        self._efforts = self._drive_train.efforts(rl, rr, fl, fr, self._swivel_torque,
+                                                  self._drive_speed, self.watchdog_tripped)
         pybullet.setJointMotorControlArray(self._body, self._joint_ids, pybullet.TORQUE_CONTROL,
                                            forces=self._efforts, physicsClientId=self._client)
 
@@ -435,7 +268,7 @@ class SwivelCarSim:
         self._swivel_torque = 0.0
         self._drive_speed = 0.0
         self._command_time = self.time
-        self._speed_integral = 0.0
+        self._drive_train.reset()
         self._efforts = [0.0] * len(self._joint_ids)
         self._acceleration = np.zeros(3)
 
@@ -505,7 +338,7 @@ class SwivelCarSim:
         if not self.config.body_collision:
             raise ValueError('body_clearance needs SimConfig(body_collision=True)')
         reach = 1.0  # [m]
-        distances = [point[8] for other in (self._ground, *self._obstacles.values())
+        distances = [point[8] for other in (self._ground, *self._obstacles.bodies.values())
                      for link in (-1, self._joint_ids[0])
                      for point in self._pb.getClosestPoints(self._body, other, reach,
                                                             linkIndexA=link)]
@@ -552,7 +385,7 @@ class SwivelCarSim:
 
     @property
     def obstacle_names(self) -> tuple[str, ...]:
-        return tuple(self._obstacles)
+        return tuple(self._obstacles.bodies)
 
     def spawn_obstacle(self, spec: StepSpec) -> str:
         """
@@ -565,59 +398,18 @@ class SwivelCarSim:
             unchanged.
 
         """
-        spec.validate()
-        name = spec.name or self._next_obstacle_name()
-        if name in self._obstacles:
-            raise ValueError(f'an obstacle named {name!r} exists already')
-        position, orientation, half = self._step_placement(spec)
-        pb = self._pb
-        shape = pb.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half.tolist())
-        if pb.getClosestPoints(bodyA=self._body, bodyB=-1, distance=0.0, collisionShapeB=shape,
-                               collisionShapePositionB=position.tolist(),
-                               collisionShapeOrientationB=orientation):
-            pb.removeCollisionShape(shape)
-            raise ValueError(f'obstacle {name!r} would overlap the robot (distance '
-                             f'{spec.distance} m, yaw {spec.yaw} rad)')
-        visual = pb.createVisualShape(pybullet.GEOM_BOX, halfExtents=half.tolist(),
-                                      rgbaColor=[0.5, 0.5, 0.8, 1.0])
-        body = pb.createMultiBody(0.0, shape, visual, position.tolist(), orientation)
-        pb.changeDynamics(body, -1, lateralFriction=spec.friction)
-        self._obstacles[name] = body
-        if not spec.name:
-            self._obstacle_counter += 1
-        return name
-
-    def _next_obstacle_name(self) -> str:
-        counter = self._obstacle_counter
-        while f'step_{counter}' in self._obstacles:
-            counter += 1
-        self._obstacle_counter = counter
-        return f'step_{counter}'
-
-    def _step_placement(self, spec: StepSpec):
-        """Centre, orientation and half extents of the box of ``spec``."""
-        base_pos, base_orn = self._base_pose()
-        rotation = np.array(pybullet.getMatrixFromQuaternion(base_orn)).reshape(3, 3)
-        heading = math.atan2(rotation[1, 0], rotation[0, 0])
-        contact = base_pos + rotation @ self.params.front_axle
-        direction = np.array([math.cos(heading), math.sin(heading), 0.0])
-        normal_yaw = heading + spec.yaw
-        normal = np.array([math.cos(normal_yaw), math.sin(normal_yaw), 0.0])
-        edge = np.array([contact[0], contact[1], 0.0]) + spec.distance * direction
-        centre = edge + normal * spec.depth / 2.0 + np.array([0.0, 0.0, spec.height / 2.0])
-        orientation = pybullet.getQuaternionFromEuler([0.0, 0.0, normal_yaw])
-        return centre, orientation, np.array([spec.depth, spec.width, spec.height]) / 2.0
+        return self._obstacles.spawn(spec, self._body, *self._base_pose(),
+                                     self.params.front_axle)
 
     def _obstacles_overlapping_robot_at(self, x: float, y: float, yaw: float) -> list[str]:
         """Names of obstacles the robot, placed at rest at (x, y, yaw), would touch."""
-        if not self._obstacles:
+        if not self._obstacles.bodies:
             return []
         pb = self._pb
         probe = pb.loadURDF(self._urdf_path, [x, y, self.params.r],
                             pybullet.getQuaternionFromEuler([0.0, 0.0, yaw]), flags=URDF_FLAGS)
         try:
-            return [name for name, body in self._obstacles.items()
-                    if pb.getClosestPoints(probe, body, 0.0)]
+            return self._obstacles.touching(probe)
         finally:
             pb.removeBody(probe)
 
@@ -631,27 +423,4 @@ class SwivelCarSim:
             No obstacle of that name.
 
         """
-        if name == '':
-            for body in self._obstacles.values():
-                self._pb.removeBody(body)
-            self._obstacles.clear()
-            return
-        if name not in self._obstacles:
-            raise ValueError(f'no obstacle named {name!r} (have: {sorted(self._obstacles)})')
-        self._pb.removeBody(self._obstacles.pop(name))
-
-
-class _Client:
-    """pybullet functions bound to one physics client."""
-
-    def __init__(self, client: int) -> None:
-        self._client = client
-
-    def __getattr__(self, name: str):
-        function = getattr(pybullet, name)
-
-        def bound(*args, **kwargs):
-            return function(*args, physicsClientId=self._client, **kwargs)
-        bound.__name__ = name
-        setattr(self, name, bound)
-        return bound
+        self._obstacles.remove(name)

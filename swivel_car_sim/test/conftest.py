@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from swivel_car_sim.physics import RobotState, SwivelCarSim
+from swivel_car_sim.physics import SwivelCarSim
+from swivel_car_sim.robot_state import RobotState
 
 CONTROL_STEPS = 5  # [1] physics steps per 0.01 s control period
 

@@ -7,7 +7,7 @@ from swivel_car_model import description
 from swivel_car_model.description import CarDescription
 
 from swivel_car_sim.config import PARAMETERS, SimNodeConfig
-from swivel_car_sim.physics import StepSpec
+from swivel_car_sim.world import StepSpec
 
 GOOD_STEP = {'name': 'step', 'height': 0.05, 'depth': 1.0, 'width': 1.5, 'distance': 0.5,
              'yaw': 0.0, 'friction': 1.0}

@@ -17,8 +17,9 @@ import pytest
 from swivel_car_model import climbing, kinematics, planar
 from swivel_car_model.description import CarDescription
 
-from swivel_car_sim.physics import SimConfig, StepSpec, SwivelCarSim
+from swivel_car_sim.physics import SimConfig, SwivelCarSim
 from swivel_car_sim.urdf import build_robot
+from swivel_car_sim.world import StepSpec
 import yaml
 
 from .conftest import SwivelHold
@@ -202,7 +203,7 @@ def _against_riser(design: CarDescription, drive_speed: float,
                 rotation = np.array(pybullet.getMatrixFromQuaternion(orientation)).reshape(3, 3)
                 axis, apex = rotation @ p.swivel_axis, position + rotation @ p.apex
                 riser_n, riser_f, riser_force = _contact_moments(
-                    sim, 'front_left_wheel_joint', sim._obstacles['riser'], axis, apex)
+                    sim, 'front_left_wheel_joint', sim._obstacles.bodies['riser'], axis, apex)
                 ground_n, ground_f, _ = _contact_moments(
                     sim, 'front_right_wheel_joint', sim._ground, axis, apex)
                 log.append([torque, state.positions[0], np.linalg.norm(riser_force[:2]),

@@ -9,7 +9,8 @@ from swivel_car_model import dynamics, kinematics, planar
 from swivel_car_model.description import CarDescription
 from swivel_car_model.params import SwivelCarParams
 
-from swivel_car_sim.physics import SimConfig, StepSpec, SwivelCarSim
+from swivel_car_sim.physics import SimConfig, SwivelCarSim
+from swivel_car_sim.world import StepSpec
 import yaml
 
 from .conftest import SwivelHold
@@ -345,7 +346,7 @@ def test_step_is_placed_relative_to_the_robot_pose(sim):
     sim.spawn_obstacle(StepSpec(name='s', height=0.2, depth=0.4, width=1.0, distance=0.3,
                                 yaw=0.25, friction=1.0))
     centre, orientation = pybullet.getBasePositionAndOrientation(
-        sim._obstacles['s'], physicsClientId=sim._client)
+        sim._obstacles.bodies['s'], physicsClientId=sim._client)
     p = sim.config.params
     heading = np.array([math.cos(0.5), math.sin(0.5)])
     edge = np.array([1.0, 2.0]) + (p.wheelbase + 0.3) * heading
