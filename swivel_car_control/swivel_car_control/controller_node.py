@@ -131,6 +131,12 @@ class ControllerNode(Node):
         self._pending: JointState | None = None  # joint_states waiting for their commands
         self._pending_since = 0.0  # [s] wall
 
+        # Built once, refilled every period: a message constructor imports and builds each
+        # nested message in Python, every time.
+        self._command = ActuatorCommand()
+        self._state = SwivelControllerState()
+        self._limited = TwistStamped()
+        self._limited.header.frame_id = self._base_frame_id
         self._command_pub = self.create_publisher(ActuatorCommand, 'actuator_command', 10)
         self._state_pub = self.create_publisher(SwivelControllerState, '~/controller_state', 10)
         self._cmd_out_pub = self.create_publisher(TwistStamped, '~/cmd_vel_out', 10)
@@ -279,15 +285,17 @@ class ControllerNode(Node):
 
     def _answer(self, msg: JointState) -> None:
         """One ActuatorCommand (and controller state) for this joint_states."""
-        t = stamp_to_seconds(msg.header.stamp)
-        command = ActuatorCommand()
-        command.header.stamp = msg.header.stamp
+        stamp = msg.header.stamp
+        command = self._command
+        command.header.stamp = stamp
         try:
-            swivel, out = self._joint_states.answer(t, msg.name, msg.position, msg.velocity)
+            swivel, out = self._joint_states.answer(
+                stamp_to_seconds(stamp), msg.name, msg.position, msg.velocity)
         except MissingJointError as error:
             # Still answer the stamp (the lockstep sim waits for it), with the safe command.
             self.get_logger().warn(f'{error}: commanding zero torque and drive',
                                    throttle_duration_sec=5.0)
+            command.swivel_torque = command.drive_speed = 0.0
             self._command_pub.publish(command)
             return
         if out.cmd_vel_timed_out:
@@ -300,8 +308,8 @@ class ControllerNode(Node):
         command.drive_speed = out.drive_speed
         self._command_pub.publish(command)
 
-        state = SwivelControllerState()
-        state.header.stamp = msg.header.stamp
+        state = self._state
+        state.header.stamp = stamp
         state.set_point = out.set_point
         state.target = out.target
         state.measured = swivel.position
@@ -318,12 +326,13 @@ class ControllerNode(Node):
         state.cmd_vel_stamp = self._driver.heard
         self._state_pub.publish(state)
 
-        limited = TwistStamped()
-        limited.header.stamp = msg.header.stamp
-        limited.header.frame_id = self._base_frame_id
-        limited.twist.linear.x = out.v_out
-        limited.twist.angular.z = out.omega_out
-        self._cmd_out_pub.publish(limited)
+        # A diagnostic: published only to a listener (a recorder that subscribes gets it).
+        if self._cmd_out_pub.get_subscription_count():
+            limited = self._limited
+            limited.header.stamp = stamp
+            limited.twist.linear.x = out.v_out
+            limited.twist.angular.z = out.omega_out
+            self._cmd_out_pub.publish(limited)
 
 
 def main(args=None) -> None:

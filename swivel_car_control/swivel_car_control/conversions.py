@@ -7,7 +7,6 @@ from geometry_msgs.msg import Quaternion
 from swivel_car_control.core.joint_states import yaw_quaternion
 
 
-def yaw_to_quaternion(yaw: float) -> Quaternion:
-    """Rotation about z by ``yaw`` [rad]."""
-    x, y, z, w = yaw_quaternion(yaw)
-    return Quaternion(x=x, y=y, z=z, w=w)
+def set_yaw(quaternion: Quaternion, yaw: float) -> None:
+    """Set ``quaternion`` to the rotation about z by ``yaw`` [rad]."""
+    quaternion.x, quaternion.y, quaternion.z, quaternion.w = yaw_quaternion(yaw)

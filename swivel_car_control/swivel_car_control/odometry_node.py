@@ -17,7 +17,7 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Empty
-from swivel_car_control.conversions import yaw_to_quaternion
+from swivel_car_control.conversions import set_yaw
 from swivel_car_control.core.joint_states import JointStateOdometry, YAW_RATE_SOURCES
 from swivel_car_control.core.odometry_input import (
     GatedOdometry, MAX_SWIVEL_RATE, Verdict, WHEEL_RATE_FACTOR)
@@ -113,6 +113,15 @@ class OdometryNode(Node):
             config.swivel_joint: MAX_SWIVEL_RATE, config.rear_left_wheel_joint: max_wheel_rate,
             config.rear_right_wheel_joint: max_wheel_rate})
         self._tf = self._make_tf_broadcaster() if config.enable_odom_tf else None
+        # Built once, refilled every period: a message constructor imports and builds each
+        # nested message in Python, every time.
+        self._odom = Odometry()
+        self._odom.header.frame_id = config.frame(config.odom_frame_id)
+        self._odom.child_frame_id = config.frame(config.base_frame_id)
+        self._transform = TransformStamped()
+        self._transform.header = self._odom.header  # the same stamp and frame
+        self._transform.child_frame_id = self._odom.child_frame_id
+        self._transform.transform.rotation = self._odom.pose.pose.orientation
 
         self._apply_config(config)
         live_parameters(self, OdometryConfig.LIVE, self._live_config, self._apply_config)
@@ -136,6 +145,8 @@ class OdometryNode(Node):
         self._config = config
         self._pose_covariance = _diagonal(config.pose_covariance_diagonal)
         self._twist_covariance = _diagonal(config.twist_covariance_diagonal)
+        self._odom.pose.covariance = self._pose_covariance
+        self._odom.twist.covariance = self._twist_covariance
 
     def _make_tf_broadcaster(self):
         try:
@@ -171,28 +182,20 @@ class OdometryNode(Node):
             self._publish(msg.header.stamp)
 
     def _publish(self, stamp) -> None:
-        c = self._config
         odometry = self._odometry
-        msg = Odometry()
+        msg = self._odom
         msg.header.stamp = stamp
-        msg.header.frame_id = c.frame(c.odom_frame_id)
-        msg.child_frame_id = c.frame(c.base_frame_id)
         msg.pose.pose.position.x = odometry.x
         msg.pose.pose.position.y = odometry.y
-        msg.pose.pose.orientation = yaw_to_quaternion(odometry.yaw)
-        msg.pose.covariance = self._pose_covariance
+        set_yaw(msg.pose.pose.orientation, odometry.yaw)
         msg.twist.twist.linear.x = odometry.v
         msg.twist.twist.angular.z = odometry.omega
-        msg.twist.covariance = self._twist_covariance
         self._odom_pub.publish(msg)
         if self._tf is not None:
-            transform = TransformStamped()
-            transform.header = msg.header
-            transform.child_frame_id = msg.child_frame_id
-            transform.transform.translation.x = odometry.x
-            transform.transform.translation.y = odometry.y
-            transform.transform.rotation = msg.pose.pose.orientation
-            self._tf.sendTransform(transform)
+            translation = self._transform.transform.translation
+            translation.x = odometry.x
+            translation.y = odometry.y
+            self._tf.sendTransform(self._transform)
 
     def _on_reset(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
         self._odometry.reset()

@@ -156,9 +156,14 @@ def test_turn_on_the_spot_command_steers_to_the_limit(controller):
 
 
 def test_missing_swivel_joint_gives_a_safe_command(controller):
+    step(controller, 1.0)
+    send_cmd_vel(controller, 0.3, 0.0, 1.0)
+    driving = step(controller, 1.01, swivel=0.1)  # the command before: not a safe one
+    assert driving.swivel_torque != 0.0 and driving.drive_speed > 0.0
     commands = controller.received['actuator_command']
-    controller.joints.publish(joint_state(2.0, names=['rear_left_wheel_joint']))
-    spin_until(controller.executor, lambda: commands, 10.0, 'command')
+    controller.joints.publish(joint_state(1.02, names=['rear_left_wheel_joint']))
+    spin_until(controller.executor, lambda: len(commands) > 2, 10.0, 'command')
+    assert commands[-1].header.stamp == joint_state(1.02).header.stamp
     assert (commands[-1].swivel_torque, commands[-1].drive_speed) == (0.0, 0.0)
 
 
@@ -402,6 +407,14 @@ def test_odometry_straight_frames_reset_and_set_pose(odometry):
     assert not bad.success and 'finite' in bad.message
     odom = feed(odometry, 2.73, 0.1)
     assert odom.pose.pose.position.x == pytest.approx(1.0)
+
+
+def test_odometry_covariances_set_live_reach_the_next_odom(odometry):
+    assert feed(odometry, 1.0, 0.0).pose.covariance[0] == 0.001
+    odometry.node.set_parameters([Parameter('pose_covariance_diagonal', value=[0.5] * 6)])
+    odom = feed(odometry, 1.01, 0.0)
+    assert (odom.pose.covariance[0], odom.pose.covariance[35]) == (0.5, 0.5)
+    assert odom.twist.covariance[0] == 0.001
 
 
 def test_odometry_without_velocities_differences_wrapped_positions(odometry):
