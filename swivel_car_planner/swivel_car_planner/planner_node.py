@@ -4,12 +4,16 @@ The planner node: climb_step as a service and as an action, one shared climb.
 The core's ``ClimbStateMachine`` steps once per controller state, on the inputs of that
 moment (``core.sync``), and the command it answers carries that moment's stamp: in a lockstep
 sim the controller applies it exactly one cycle later (its ``lockstep_swivel_command``), so a
-climb does not depend on how busy the machine is. The service and action callbacks are
-coroutines that await the plan's and the climb's futures, so nothing blocks the executor: a
-single-threaded one serves everything. (Blocking callbacks on a MultiThreadedExecutor made its
-spin loop busy-wait at full CPU while a climb ran.) Planning takes seconds of CPU when a backup
-is searched: it runs on a worker thread, whose result the executor takes through a guard
-condition.
+climb does not depend on how busy the machine is. It runs on the EventsExecutor (a message
+in about a quarter of a SingleThreadedExecutor's time), and nothing waits for a climb in a
+callback or a task: a request starts the planning, the planning's end starts the climb, the
+climb's end answers (the service's callback returns a future of its response, sent once that
+completes; an action goal executes only then, to report the result). A coroutine waiting for
+the climb would cost CPU all along: the EventsExecutor resumes every waiting task after each
+message, and spun one callback at a time (``run_node``) it resumes them again at once, a busy
+loop. Planning takes seconds of CPU when a backup is searched: it runs on a worker thread,
+which hands its result to the executor as a task (``create_task`` wakes it from any thread; the
+EventsExecutor has no guard conditions).
 """
 
 from __future__ import annotations
@@ -21,14 +25,14 @@ import threading
 import time
 from typing import Callable
 
+from builtin_interfaces.msg import Time as TimeMsg
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.action.server import ServerGoalHandle
-from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.clock import Clock, ClockType
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.service import Service
 from rclpy.task import Future
 from rclpy.time import Time
 from sensor_msgs.msg import Imu, JointState
@@ -38,10 +42,11 @@ from swivel_car_model.checks import check_number
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
-from swivel_car_planner.conversions import outcome_to_msg, plan_to_msg, request_from
+from swivel_car_planner.conversions import (
+    imu_fields, odom_fields, outcome_to_msg, plan_to_msg, request_from)
 from swivel_car_planner.core import (
-    capability, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs, make_plan,
-    PlanError, PlannerConfig, validate_request)
+    capability, ClimbPlan as Plan, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs,
+    make_plan, PlanError, PlannerConfig, validate_request)
 from swivel_car_planner.core.sync import InputSync, Tick
 from swivel_car_ros.ros_params import (
     declare_description, moment_seconds, run_node, stamp_to_seconds)
@@ -61,7 +66,8 @@ class _ActiveClimb:
     """
 
     new_machine: Callable[[], ClimbStateMachine]
-    done: Future
+    plan: Plan
+    answer: Callable[[_Result], None]  # takes the result once the climb has ended
     goal_handle: ServerGoalHandle | None = None
     machine: ClimbStateMachine = field(init=False)
     first_command: tuple[Command, float] | None = None  # (command, stamp [s])
@@ -88,6 +94,18 @@ class _Result:
         return message
 
 
+class _AnsweredLater(Service):
+    """
+    A service whose callback returns a Future of its response, sent once that completes.
+
+    Both executors send what a service callback returns through ``send_response``.
+    """
+
+    def send_response(self, response: Future, header) -> None:
+        response.add_done_callback(
+            lambda done: Service.send_response(self, done.result(), header))
+
+
 class _PlanWorker:
     """
     Plans on worker threads; each plan's future completes on the node's executor.
@@ -96,27 +114,25 @@ class _PlanWorker:
     """
 
     def __init__(self, node: Node) -> None:
+        self._node = node
         self._lock = threading.Lock()
-        self._finished: list[tuple[Future, object, Exception | None]] = []  # (future, plan, error)
         self._closed = False
-        self._guard = node.create_guard_condition(self._complete)
 
     def plan(self, robot, config: PlannerConfig, request: ClimbRequest,
              whole_car_limit: float) -> Future:
         """Start ``make_plan`` on a thread; its future gets the plan, or the PlanError raised."""
         future = Future()
+        executor = self._node.executor
 
         def work() -> None:
-            plan = error = None
             try:
-                plan = make_plan(robot, config, request, whole_car_limit)
-            except Exception as raised:  # the awaiting callback raises it
-                error = raised
+                complete, value = future.set_result, make_plan(
+                    robot, config, request, whole_car_limit)
+            except Exception as raised:  # raised again by the future's result()
+                complete, value = future.set_exception, raised
             with self._lock:
-                if self._closed:
-                    return
-                self._finished.append((future, plan, error))
-                self._guard.trigger()
+                if not self._closed:
+                    executor.create_task(complete, value)
 
         threading.Thread(target=work, name='climb_step planning', daemon=True).start()
         return future
@@ -124,15 +140,6 @@ class _PlanWorker:
     def close(self) -> None:
         with self._lock:
             self._closed = True
-
-    def _complete(self) -> None:
-        with self._lock:
-            finished, self._finished = self._finished, []
-        for future, plan, error in finished:
-            if error is None:
-                future.set_result(plan)
-            else:
-                future.set_exception(error)
 
 
 class PlannerNode(Node):
@@ -177,21 +184,21 @@ class PlannerNode(Node):
         self._quiet_checks = 0  # input checks in a row that saw no tick
         self._quiet_wall_checks = 0
 
-        self.create_subscription(Odometry, 'odom', self._on_odom, 10)
+        # Serialized: the planner reads a few fields of each (conversions.odom_fields).
+        self.create_subscription(Odometry, 'odom', self._on_odom, 10, raw=True)
         self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
-        self.create_subscription(Imu, 'imu', self._on_imu, 10)
+        self.create_subscription(Imu, 'imu', self._on_imu, 10, raw=True)
         self.create_subscription(SwivelControllerState, _CONTROLLER_STATE,
                                  self._on_controller_state, 10)
         self.create_subscription(Header, 'sim/reset_event', self._on_sim_reset, 10)
         self._command_pub = self.create_publisher(SwivelCommand, 'swivel_command', 10)
-        # Reentrant: a climb's coroutine holds its callback group while it awaits.
-        requests = ReentrantCallbackGroup()
-        self.create_service(ClimbStepService, 'climb_step', self._on_service,
-                            callback_group=requests)
+        self.create_service(ClimbStepService, 'climb_step',
+                            self._on_service).__class__ = _AnsweredLater
         self._action = ActionServer(
             self, ClimbStepAction, 'climb_step', execute_callback=self._on_execute,
             goal_callback=self._on_goal, cancel_callback=self._on_cancel,
-            callback_group=requests)
+            handle_accepted_callback=self._on_accepted)
+        self._goal_results: dict[bytes, _Result] = {}  # goal id -> the result of its climb
         self.create_timer(self._ready_timeout / 4.0, self._check_inputs_alive)
         # A dead sim stops /clock, and with it every sim-time timer: this one is not stopped.
         self.create_timer(self._ready_timeout / 4.0, self._check_sim_alive,
@@ -260,29 +267,49 @@ class PlannerNode(Node):
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def _on_odom(self, msg: Odometry) -> None:
-        q = msg.pose.pose.orientation
-        self._add(inputs.ODOM, msg, inputs.odom_values(
-            msg.pose.pose.position.x, msg.pose.pose.position.y, (q.x, q.y, q.z, q.w),
-            msg.twist.twist.linear.x))
+    def _on_odom(self, data: bytes) -> None:
+        if self._heard(inputs.ODOM):
+            fields = self._read(odom_fields, data)
+            if fields is not None:
+                stamp, x, y, orientation, speed = fields
+                self._add(inputs.ODOM, stamp, inputs.odom_values(x, y, orientation, speed))
 
     def _on_joint_states(self, msg: JointState) -> None:
         values = inputs.joint_state_values(self._swivel_joint, msg.name, msg.position,
                                            msg.velocity)
-        if values is not None:
-            self._add(inputs.JOINT_STATES, msg, values)
+        if values is not None and self._heard(inputs.JOINT_STATES):
+            self._add(inputs.JOINT_STATES, msg.header.stamp, values)
 
-    def _on_imu(self, msg: Imu) -> None:
-        q = msg.orientation
-        self._add(inputs.IMU, msg, inputs.imu_values((q.x, q.y, q.z, q.w)))
+    def _on_imu(self, data: bytes) -> None:
+        if self._heard(inputs.IMU):
+            fields = self._read(imu_fields, data)
+            if fields is not None:
+                stamp, orientation = fields
+                self._add(inputs.IMU, stamp, inputs.imu_values(orientation))
 
     def _on_controller_state(self, msg: SwivelControllerState) -> None:
-        self._add(_CONTROLLER_STATE, msg, inputs.controller_state_values(
-            msg.set_point, msg.torque, moment_seconds(msg.swivel_command_stamp)))
+        if self._heard(_CONTROLLER_STATE):
+            self._add(_CONTROLLER_STATE, msg.header.stamp, inputs.controller_state_values(
+                msg.set_point, msg.torque, moment_seconds(msg.swivel_command_stamp)))
 
-    def _add(self, topic: str, msg, value: tuple) -> None:
+    def _heard(self, topic: str) -> bool:
+        """
+        Note a message on ``topic``; tell whether its values are wanted: while a climb runs.
+
+        A climb starts from the inputs heard after its planning (``_planned``), so none is
+        kept before.
+        """
         self._received[topic] = self._now()
-        stamp = msg.header.stamp
+        return self._climb is not None
+
+    def _read(self, read: Callable[[bytes], tuple], data: bytes) -> tuple | None:
+        try:
+            return read(data)
+        except ValueError as error:
+            self.get_logger().error(f'input ignored: {error}', throttle_duration_sec=5.0)
+            return None
+
+    def _add(self, topic: str, stamp: TimeMsg, value: tuple) -> None:
         for tick in self._sync.add(topic, stamp_to_seconds(stamp), value):
             self._on_tick(tick)
 
@@ -295,33 +322,48 @@ class PlannerNode(Node):
 
     # --- the climb ------------------------------------------------------------------------
 
-    async def _run(self, request: ClimbRequest, goal_handle=None) -> _Result:
-        """Validate, plan and (unless plan_only) climb; awaits the plan and the climb's end."""
+    def _start(self, request: ClimbRequest, answer: Callable[[_Result], None],
+               goal_handle: ServerGoalHandle | None = None) -> None:
+        """Validate, plan and (unless plan_only) climb; ``answer`` takes the result at the end."""
         code, message = validate_request(request, self.config)
         if code != ErrorCode.NONE:
-            return self._failure(code, message)
-        if request.plan_only:
-            try:
-                plan = await self._plan(request)
-            except PlanError as error:
-                return self._failure(error.code, error.message)
-            return _Result(True, int(ErrorCode.NONE), 'plan only: the robot did not move',
-                           plan_to_msg(plan), ClimbOutcome())
-        missing = self._missing_inputs()
-        if missing:
-            return self._failure(ErrorCode.NOT_READY,
-                                 f'no recent message on {", ".join(missing)}: are the sim, '
-                                 f'controller and odometry running?')
-        if self._busy():
-            return self._failure(ErrorCode.BUSY, 'a climb is already being planned or running')
+            answer(self._failure(code, message))
+            return
+        if not request.plan_only:
+            missing = self._missing_inputs()
+            if missing:
+                answer(self._failure(ErrorCode.NOT_READY,
+                                     f'no recent message on {", ".join(missing)}: are the sim, '
+                                     f'controller and odometry running?'))
+                return
+            if self._busy():
+                answer(self._failure(ErrorCode.BUSY,
+                                     'a climb is already being planned or running'))
+                return
+            self._planning = True
         resets = self._resets
-        self._planning = True
+
+        def planned(future: Future) -> None:
+            result = self._planned(request, future, resets, answer, goal_handle)
+            if result is not None:
+                answer(result)
+
+        self._plans.plan(self.robot, self.config, request, self.whole_car_limit
+                         ).add_done_callback(planned)
+
+    def _planned(self, request: ClimbRequest, planned: Future, resets: int,
+                 answer: Callable[[_Result], None],
+                 goal_handle: ServerGoalHandle | None) -> _Result | None:
+        """Return the result of a finished planning; None when the climb has started."""
+        if not request.plan_only:
+            self._planning = False
         try:
-            plan = await self._plan(request)
+            plan = planned.result()
         except PlanError as error:
             return self._failure(error.code, error.message)
-        finally:
-            self._planning = False
+        if request.plan_only:
+            return _Result(True, int(ErrorCode.NONE), 'plan only: the robot did not move',
+                           plan_to_msg(plan), ClimbOutcome())
         if goal_handle is not None and goal_handle.is_cancel_requested:
             return self._failure(ErrorCode.CANCELED, 'canceled while planning: nothing moved')
         if self._resets != resets:
@@ -330,7 +372,7 @@ class PlannerNode(Node):
         climb = _ActiveClimb(
             lambda: ClimbStateMachine(self.robot, self.config, plan, request.step_distance,
                                       request.step_yaw, request.time_allowance),
-            Future(), goal_handle)
+            plan, answer, goal_handle)
         # The climb starts from the moments after its planning (seconds, when a backup is
         # searched): a tick of the inputs collected before would be that old.
         self._sync.clear()
@@ -343,17 +385,7 @@ class PlannerNode(Node):
             f'climbing a {request.step_height:.3f} m step {request.step_distance:.2f} m ahead: '
             f'swivel {plan.swivel_angle:.3f} rad, approach heading '
             f'{plan.approach_heading:.3f} rad')
-        outcome = await climb.done
-        if outcome.success:
-            self.get_logger().info(f'climb ended: {outcome.message}')
-        else:
-            self.get_logger().warning(f'climb ended ({outcome.error_code.name}): '
-                                      f'{outcome.message}')
-        return _Result(outcome.success, int(outcome.error_code), outcome.message,
-                       plan_to_msg(plan), outcome_to_msg(outcome))
-
-    def _plan(self, request: ClimbRequest) -> Future:
-        return self._plans.plan(self.robot, self.config, request, self.whole_car_limit)
+        return None
 
     def _busy(self) -> bool:
         return self._planning or self._climb is not None
@@ -485,9 +517,16 @@ class PlannerNode(Node):
         The last command holds it; the controller keeps holding it, and cmd_vel steers again.
         """
         self._climb = None
-        for command in inputs.end_commands(climb.machine.outcome):
+        outcome = climb.machine.outcome
+        for command in inputs.end_commands(outcome):
             self._publish_command(command, stamp)
-        climb.done.set_result(climb.machine.outcome)
+        if outcome.success:
+            self.get_logger().info(f'climb ended: {outcome.message}')
+        else:
+            self.get_logger().warning(f'climb ended ({outcome.error_code.name}): '
+                                      f'{outcome.message}')
+        climb.answer(_Result(outcome.success, int(outcome.error_code), outcome.message,
+                             plan_to_msg(climb.plan), outcome_to_msg(outcome)))
 
     def _publish_command(self, command: Command, stamp: float) -> None:
         msg = SwivelCommand()
@@ -511,9 +550,11 @@ class PlannerNode(Node):
 
     # --- service and action ---------------------------------------------------------------
 
-    async def _on_service(self, request, response):
-        result = await self._run(request_from(request, with_time_allowance=False))
-        return result.fill(response)
+    def _on_service(self, request, response) -> Future:
+        answered = Future()
+        self._start(request_from(request, with_time_allowance=False),
+                    lambda result: answered.set_result(result.fill(response)))
+        return answered
 
     def _on_goal(self, goal) -> GoalResponse:
         if self._busy() and not goal.plan_only:
@@ -525,9 +566,17 @@ class PlannerNode(Node):
     def _on_cancel(self, goal_handle) -> CancelResponse:
         return CancelResponse.ACCEPT
 
-    async def _on_execute(self, goal_handle):
-        result = await self._run(
-            request_from(goal_handle.request, with_time_allowance=True), goal_handle)
+    def _on_accepted(self, goal_handle: ServerGoalHandle) -> None:
+        """Start the goal's climb; the goal executes once it has ended, to report the result."""
+        def answer(result: _Result) -> None:
+            self._goal_results[bytes(goal_handle.goal_id.uuid)] = result
+            goal_handle.execute()
+
+        self._start(request_from(goal_handle.request, with_time_allowance=True), answer,
+                    goal_handle)
+
+    def _on_execute(self, goal_handle: ServerGoalHandle) -> ClimbStepAction.Result:
+        result = self._goal_results.pop(bytes(goal_handle.goal_id.uuid))
         if result.success:
             goal_handle.succeed()
         elif result.error_code == ErrorCode.CANCELED and goal_handle.is_cancel_requested:
@@ -543,8 +592,7 @@ class PlannerNode(Node):
 
 
 def main(args=None) -> None:
-    # Its service callback awaits the climb, which the EventsExecutor cannot run.
-    sys.exit(run_node(PlannerNode, 'planner', args, SingleThreadedExecutor))
+    sys.exit(run_node(PlannerNode, 'planner', args))
 
 
 if __name__ == '__main__':

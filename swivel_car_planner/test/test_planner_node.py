@@ -21,6 +21,7 @@ import pytest
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
@@ -54,10 +55,10 @@ class Rig:
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=next_domain_id())
         self.planner = PlannerNode_with_sim_time(self.context)
-        self.planner_executor = SingleThreadedExecutor(context=self.context)
+        # The executor run_node gives it.
+        self.planner_executor = EventsExecutor(context=self.context)
         self.planner_executor.add_node(self.planner)
-        # Stopped before the executor is shut down: shutdown() destroys the executor's guard
-        # condition, which a spin() still running in this thread may trigger.
+        # Stopped before the executor is shut down, which waits for a spin still running.
         self._stop = threading.Event()
         self.thread = threading.Thread(target=self._spin_planner, daemon=True)
         self.thread.start()

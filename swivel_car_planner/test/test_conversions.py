@@ -1,0 +1,46 @@
+"""The planner's readers of serialized odom and imu against rclpy's own serialization."""
+
+from nav_msgs.msg import Odometry
+import pytest
+from rclpy.serialization import serialize_message
+from sensor_msgs.msg import Imu
+from swivel_car_planner.conversions import imu_fields, odom_fields
+
+# Frame ids of every length modulo 8: each puts the fields after them at another alignment.
+FRAME_IDS = ['', 'o', 'od', 'odo', 'odom', 'odom_', 'odom_1', 'odom_12', 'base_footprint']
+
+
+@pytest.mark.parametrize('frame_id', FRAME_IDS)
+@pytest.mark.parametrize('child_frame_id', FRAME_IDS)
+def test_odom_fields_are_the_messages(frame_id, child_frame_id):
+    msg = Odometry()
+    msg.header.stamp.sec, msg.header.stamp.nanosec = 123, 456_000_789
+    msg.header.frame_id, msg.child_frame_id = frame_id, child_frame_id
+    position, orientation = msg.pose.pose.position, msg.pose.pose.orientation
+    position.x, position.y, position.z = 1.25, -2.5, 0.125
+    orientation.x, orientation.y, orientation.z, orientation.w = 0.1, -0.2, 0.3, 0.9
+    msg.pose.covariance = [float(i) for i in range(36)]
+    msg.twist.twist.linear.x, msg.twist.twist.linear.y = 0.75, -9.0
+    stamp, x, y, quaternion, speed = odom_fields(serialize_message(msg))
+    assert (stamp.sec, stamp.nanosec) == (123, 456_000_789)
+    assert (x, y, quaternion, speed) == (1.25, -2.5, (0.1, -0.2, 0.3, 0.9), 0.75)
+
+
+@pytest.mark.parametrize('frame_id', FRAME_IDS)
+def test_imu_fields_are_the_messages(frame_id):
+    msg = Imu()
+    msg.header.stamp.sec, msg.header.stamp.nanosec = 7, 10_000_000
+    msg.header.frame_id = frame_id
+    msg.orientation.x, msg.orientation.y, msg.orientation.z = 0.01, 0.2, -0.03
+    msg.orientation.w = 0.97
+    msg.orientation_covariance = [-1.0] * 9
+    stamp, quaternion = imu_fields(serialize_message(msg))
+    assert (stamp.sec, stamp.nanosec) == (7, 10_000_000)
+    assert quaternion == (0.01, 0.2, -0.03, 0.97)
+
+
+def test_another_encoding_is_refused():
+    data = bytearray(serialize_message(Imu()))
+    data[1] = 0  # big-endian
+    with pytest.raises(ValueError, match='encapsulation 0000'):
+        imu_fields(bytes(data))
