@@ -25,8 +25,8 @@ PARAMETERS: dict[str, tuple[object, str]] = {
                               'as possible'),
     'lockstep': (False, 'advance one control_period per ActuatorCommand stamped with the '
                         'last joint_states stamp'),
-    'lockstep_timeout': (1.0, '[s] wall time to wait for the command in lockstep before '
-                              'advancing anyway; 0 = wait forever'),
+    'lockstep_timeout': (1.0, '[s] wall time to wait for the command in lockstep; then the '
+                              'sim runs at real time until a command comes; 0 = wait forever'),
     'lockstep_real_time_factor': (0.0, '[1] in lockstep, at most this much sim time per wall '
                                        'time, so that nodes outside the lockstep keep up; '
                                        '0 = as fast as the controller answers'),

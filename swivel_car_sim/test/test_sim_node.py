@@ -291,7 +291,7 @@ def test_reset_announces_the_first_state_of_the_new_world_and_drops_older_comman
 
 
 def test_lockstep_timeout_advances_and_the_watchdog_stops_the_drive(harness_factory):
-    # No controller answers: the sim advances every lockstep_timeout (wall) and a single
+    # No controller answers: the sim advances after lockstep_timeout (wall) and a single
     # command acts until the watchdog (sim time) expires.
     h = harness_factory(lockstep=True, lockstep_timeout=0.1, watchdog_timeout=0.05)
     spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
@@ -300,6 +300,24 @@ def test_lockstep_timeout_advances_and_the_watchdog_stops_the_drive(harness_fact
     assert any(m.effort[0] == 3.0 for m in h.joint_states)
     assert h.sim.sim.watchdog_tripped
     assert h.joint_states[-1].effort[0] == 0.0
+
+
+def test_after_a_lockstep_timeout_the_sim_runs_at_real_time_until_a_command_comes(
+        harness_factory):
+    # Before, it advanced one period per lockstep_timeout: with a killed controller, 1 s of
+    # sim time took 100 timeouts.
+    h = harness_factory(lockstep=True, lockstep_timeout=1.0)
+    spin_until(h.executor, lambda: h.sim.sim.time > 0.5, TIMEOUT, '50 periods on one timeout')
+    # A command, even for a state already past, brings the lockstep back: the sim waits for
+    # the command of its state again (here, for less than lockstep_timeout).
+    h.command(h.joint_states[-1].header.stamp, swivel_torque=1.0, drive_speed=0.0)
+    states = []
+    for wait in (0.1, 0.3):
+        end = time.monotonic() + wait
+        while time.monotonic() < end:
+            h.executor.spin_once(timeout_sec=0.01)
+        states.append(_ns(h.joint_states[-1].header.stamp))
+    assert states[0] == states[1]
 
 
 @pytest.mark.parametrize('name, value, message', [
