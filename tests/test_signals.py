@@ -21,7 +21,7 @@ NODES = [('swivel_car_control', 'controller_node', SIM_TIME),
          ('swivel_car_sim', 'sim_node', {'lockstep': True, 'lockstep_timeout': 1.0})]
 
 
-@pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM] * 2,
+@pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM],
                          ids=lambda s: signal.Signals(s).name)
 def test_a_signal_ends_every_busy_node_with_exit_0_and_no_traceback(signum):
     domain_id = next_domain_id()

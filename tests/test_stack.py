@@ -4,6 +4,16 @@ The whole stack as a user runs it, judged by the sim's ground truth.
 The four installed node executables, each in its own process, on sim time in lockstep, driven
 through cmd_vel and climb_step.
 
+The sim runs unpaced. This test's node is a driver in the lockstep chain: it answers every
+controller state with a cmd_vel stamped with it (zero when it does not drive), and the
+controller waits for that answer as for the planner's; it answers a state only once it holds
+that moment's ground truth and odometry, so the sim never runs ahead of what the test sees.
+To test a deadman it leaves the chain with one unstamped cmd_vel, from whose state the
+deadman counts. Where nothing holds the sim (after such a release, or with the controller
+killed: the sim then runs at real time after its lockstep_timeout), the subscriptions keep
+10 s of messages, and a stop is measured from the stamp of what starts it (the last command
+heard), never from the moment the test looks.
+
 One stack serves the module (starting four processes costs seconds): each test begins by
 restarting whatever node is not running and resetting the sim and the odometry, so it does
 not depend on how the one before it ended.
@@ -11,6 +21,7 @@ not depend on how the one before it ended.
 
 from __future__ import annotations
 
+from collections import deque
 import math
 import os
 import time
@@ -34,7 +45,7 @@ from std_srvs.srv import Empty, SetBool
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
-from swivel_car_ros.ros_params import stamp_to_seconds
+from swivel_car_ros.ros_params import moment_seconds, stamp_to_seconds
 from swivel_car_testing import (
     lockstep_parameters, next_domain_id, NodeProcess, spin_until, start_node)
 
@@ -42,9 +53,14 @@ NODES = {'sim': ('swivel_car_sim', 'sim_node'),
          'controller': ('swivel_car_control', 'controller_node'),
          'odometry': ('swivel_car_control', 'odometry_node'),
          'planner': ('swivel_car_planner', 'planner_node')}
-# A killed controller must not freeze the lockstep sim for long: after this many wall seconds
-# without a command it steps on with its watchdog.
-LOCKSTEP_TIMEOUT = 0.1  # [s]
+# After this many wall seconds without a command the sim takes the controller for gone and
+# runs on at real time with its watchdog (a killed controller); the controller waits half
+# of it for the planner and this test's driver, generous for a loaded machine.
+LOCKSTEP_TIMEOUT = 3.0  # [s]
+# Messages the test keeps per topic: 10 s of sim time, so an unpaced sim that runs ahead of
+# the test's node (nothing holds it while no one drives) loses none of them on the way.
+QUEUE = 1000
+CONTROL_PERIOD = 0.01  # [s] sim_node.yaml
 # The controller's deadmans (controller_node.yaml), and the most its drive limit
 # (max_linear_acceleration 1 m/s^2) then takes to stop the car from 0.3 m/s.
 DEADMAN = 0.5  # [s]
@@ -69,12 +85,21 @@ class Stack:
         self.truth: list[Odometry] = []
         self.odom: list[Odometry] = []
         self.resets: list[Header] = []
-        self.user.create_subscription(Odometry, 'ground_truth/odom', self.truth.append, 100)
-        self.user.create_subscription(Odometry, 'odom', self.odom.append, 100)
-        self.user.create_subscription(Header, 'sim/reset_event', self.resets.append, 10)
         self.controller_states: list[SwivelControllerState] = []
+        # The driver: the cmd_vel it answers the states with, whether it is to leave the
+        # chain with the next answer, whether it has (then it answers nothing), and the
+        # states it has yet to answer.
+        self.twist = (0.0, 0.0)  # ([m/s], [rad/s])
+        self.releasing = False
+        self.silent = False
+        self.released_at = 0.0  # [s] the state the last release answered
+        self.unanswered: deque[SwivelControllerState] = deque(maxlen=QUEUE)
+        self.odom_time: float | None = None  # [s] of the running odometry's last odom
+        self.user.create_subscription(Odometry, 'ground_truth/odom', self._on_truth, QUEUE)
+        self.user.create_subscription(Odometry, 'odom', self._on_odom, QUEUE)
+        self.user.create_subscription(Header, 'sim/reset_event', self.resets.append, 10)
         self.user.create_subscription(SwivelControllerState, 'controller/controller_state',
-                                      self.controller_states.append, 100)
+                                      self._on_controller_state, QUEUE)
         self.cmd_vel = self.user.create_publisher(TwistStamped, 'cmd_vel', 10)
         # A user's (or a faulty driver's) messages on the sim's and the planner's topics.
         self.clock = self.user.create_publisher(Clock, '/clock', 10)
@@ -91,19 +116,70 @@ class Stack:
 
     def start(self, name: str) -> NodeProcess:
         package, executable = NODES[name]
-        # Paced at real time: this test's node, outside the lockstep chain, drives with
-        # cmd_vel and judges the car the moment after a kill, and before a climb the planner
-        # is outside it too (unpaced, it fell behind once: "no complete input").
         return start_node(package, executable, self.domain_id, {
-            'use_sim_time': True, **lockstep_parameters(executable, LOCKSTEP_TIMEOUT)})
+            'use_sim_time': True, **lockstep_parameters(
+                executable, LOCKSTEP_TIMEOUT, real_time_factor=0.0, cmd_vel_driver=True)})
+
+    def _on_truth(self, msg: Odometry) -> None:
+        self.truth.append(msg)
+        self._answer()
+
+    def _on_odom(self, msg: Odometry) -> None:
+        self.odom.append(msg)
+        if 'odometry' in self.processes:  # not one still on its way from a killed one
+            self.odom_time = stamp_to_seconds(msg.header.stamp)
+        self._answer()
+
+    def _on_controller_state(self, msg: SwivelControllerState) -> None:
+        self.controller_states.append(msg)
+        self.unanswered.append(msg)
+        self._answer()
+
+    def _seen_until(self) -> float:
+        """Return the latest moment of which this node holds the truth and the odometry [s]."""
+        if not self.truth:
+            return -math.inf
+        seen = stamp_to_seconds(self.truth[-1].header.stamp)
+        # The odometry, outside the chain, would otherwise lag more than the joint_states
+        # kept for it and skip states.
+        if self.odom_time is not None:
+            seen = min(seen, self.odom_time)
+        return seen
+
+    def _answer(self) -> None:
+        """Answer the newest controller state whose moment this node has seen."""
+        if self.silent:
+            self.unanswered.clear()
+            return
+        seen = self._seen_until()
+        due = [s for s in self.unanswered if stamp_to_seconds(s.header.stamp) <= seen]
+        if not due:
+            return
+        # The newest; a faulty joint_states' answer stamped far ahead waits in the queue.
+        state = max(due, key=lambda s: stamp_to_seconds(s.header.stamp))
+        for answered in due:
+            self.unanswered.remove(answered)
+        msg = TwistStamped()
+        msg.twist.linear.x, msg.twist.angular.z = self.twist
+        if self.releasing:
+            # Unstamped: the controller takes it as heard at this state and waits no more.
+            self.releasing, self.silent = False, True
+            self.released_at = stamp_to_seconds(state.header.stamp)
+        else:
+            msg.header.stamp = state.header.stamp
+        self.cmd_vel.publish(msg)
 
     def kill(self, name: str) -> None:
         """Kill node ``name`` with kill -9, as a crash would end it."""
         self.processes.pop(name).kill()
+        if name == 'odometry':
+            self.odom_time = None
 
     def restart(self, name: str) -> None:
         """Start node ``name`` again, as the launch files' respawn does."""
         self.processes[name] = self.start(name)
+        if name == 'odometry':
+            self.odom_time = None  # until the new one publishes
 
     def spin_until(self, condition, timeout: float = 60.0, what: str = 'condition') -> None:
         def checked() -> bool:
@@ -127,6 +203,7 @@ class Stack:
         if any(not climb.done() for climb in self.climbs):
             self.kill('planner')  # a climb left running would go on in the reset world
         self.climbs.clear()
+        self.twist, self.releasing, self.silent = (0.0, 0.0), False, False
         counts = len(self.truth), len(self.controller_states), len(self.odom)
         for name in NODES:
             if name not in self.processes or not self.processes[name].running():
@@ -138,6 +215,7 @@ class Stack:
         self.reset()
         self.call(self.reset_odometry, Empty.Request(), 'odometry/reset')
         self.wait_sim_time(0.2, 'the odometry reset')
+        self.command(0.0)
 
     def reset(self) -> float:
         """
@@ -166,29 +244,77 @@ class Stack:
         end = time.monotonic() + duration
         self.spin_until(lambda: time.monotonic() > end, duration + 10.0, what)
 
+    def command(self, speed: float, omega: float = 0.0) -> None:
+        """
+        Answer every controller state from now on with this cmd_vel, in the chain.
+
+        Where the sim ran unheld (after a release, or while a node this one waits for was
+        gone) this node may be behind it: the cmd_vel in force (zero after a release) first,
+        until the controller waits for this node again (its states report an answer to the
+        state before), so that the new one applies from a state of now.
+        """
+        if self.silent:
+            self.twist, self.silent = (0.0, 0.0), False
+        self.spin_until(self._in_step, 60.0, 'the driver to be in the chain')
+        self.twist, self.releasing = (speed, omega), False
+
+    def _in_step(self) -> bool:
+        if not self.controller_states:
+            return False
+        state = self.controller_states[-1]
+        t = stamp_to_seconds(state.header.stamp)
+        return t - 1.5 * CONTROL_PERIOD <= moment_seconds(state.cmd_vel_stamp) < t
+
+    def release(self) -> float:
+        """
+        Leave the chain: answer the next state with the cmd_vel, unstamped, then nothing.
+
+        Returns the time of that state [s]: the cmd_vel deadman counts from it.
+        """
+        self.releasing = True
+        self.spin_until(lambda: self.silent, 60.0, 'the release')
+        return self.released_at
+
     def drive(self, speed: float, duration: float, omega: float = 0.0,
               until=lambda: False) -> None:
-        """Publish cmd_vel at 20 Hz until ``until()``, for at most ``duration`` of sim time [s]."""
+        """Drive with cmd_vel until ``until()``, at most ``duration`` of sim time [s]; then 0."""
+        self.command(speed, omega)
         end = self.sim_time() + duration
-        while self.sim_time() < end and not until():
-            # A zero stamp: the controller stamps it on receipt, so a moment's lag of this
-            # node behind the sim cannot make the command look stale to the deadman.
-            msg = TwistStamped()
-            msg.twist.linear.x = speed
-            msg.twist.angular.z = omega
-            self.cmd_vel.publish(msg)
-            self.wait_sim_time(0.05, 'sim time while driving')
+        self.spin_until(lambda: self.sim_time() >= end or until(), 120.0,
+                        'sim time while driving')
+        self.command(0.0)
 
     def stop(self, within: float) -> None:
         """Stop the car with a zero cmd_vel within ``within`` seconds of sim time."""
         self.drive(0.0, within, until=lambda: self.speed() < 0.01)
         assert self.speed() < 0.01, 'a zero cmd_vel did not stop the car'
 
-    def wait_stopped(self, within: float, what: str) -> None:
-        """Wait until the car stands (ground truth), within ``within`` seconds of sim time."""
+    def wait_stopped(self, within: float, what: str, since=None) -> None:
+        """
+        Wait until the car stands (ground truth), within ``within`` seconds of sim time.
+
+        Counted from ``since()`` [s], evaluated once it stands, or else from now, to the
+        first standing moment after the last moving one.
+        """
         start = self.sim_time()
         self.spin_until(lambda: self.speed() < 0.02, 120.0, what)
-        assert self.sim_time() - start <= within, f'{what}: {self.sim_time() - start:.2f} s'
+        if since is not None:
+            start = since()
+        stopped = self.sim_time()
+        for msg in reversed(self.truth):
+            t = stamp_to_seconds(msg.header.stamp)
+            if t < start or abs(msg.twist.twist.linear.x) >= 0.02:
+                break
+            stopped = t
+        assert stopped - start <= within, f'{what}: {stopped - start:.2f} s'
+
+    def last_command_state(self) -> float:
+        """Return the stamp of the last state the controller answered [s]."""
+        return stamp_to_seconds(self.controller_states[-1].header.stamp)
+
+    def last_swivel_command_heard(self) -> float:
+        """Return the stamp of the last swivel_command the controller reports heard [s]."""
+        return stamp_to_seconds(self.controller_states[-1].swivel_command_stamp)
 
     def wait_planner_ready(self) -> None:
         """
@@ -273,7 +399,8 @@ def stack(shared_stack: Stack) -> Stack:
 def test_drive_then_climb_a_step(stack: Stack):
     stack.wait_planner_ready()
     start = stack.x()
-    stack.drive(0.3, 1.0)
+    stack.command(0.3)
+    stack.wait_sim_time(1.0, 'the drive')
     assert stack.x() - start > 0.2, 'cmd_vel did not move the car forward'
 
     p = SwivelCarParams()
@@ -292,6 +419,7 @@ def test_drive_then_climb_a_step(stack: Stack):
     response = stack.start_climb(ClimbStep.Request(
         step_height=height, step_distance=edge_x - p.wheelbase - stack.x(), step_yaw=0.0,
         plan_only=False))
+    stack.command(0.0)  # for when the planner releases the car
     stack.spin_until(response.done, 600.0, 'climb_step')
     result = response.result()
     assert result.success, f'{result.error_code}: {result.message}'
@@ -308,7 +436,9 @@ def test_a_sim_reset_leaves_the_car_at_rest_until_a_new_command(stack: Stack):
     Found by the soak: after sim/reset the controller steered the swivel back to the angle it
     held before, and went on with the cmd_vel given before.
     """
-    stack.drive(0.2, 1.5, omega=0.6)
+    stack.command(0.2, omega=0.6)
+    stack.wait_sim_time(1.5, 'the drive')
+    stack.release()  # the cmd_vel still in force at the reset
     assert abs(stack.controller_states[-1].measured) > 0.3, 'the swivel did not turn'
     reset_time = stack.reset()
     stack.wait_sim_time(1.0, 'the reset car to stand')
@@ -323,11 +453,14 @@ def test_a_sim_reset_leaves_the_car_at_rest_until_a_new_command(stack: Stack):
 
 
 def test_killed_controller_stops_the_car_and_a_restart_recovers(stack: Stack):
-    stack.drive(0.3, 1.0)
+    stack.command(0.3)
+    stack.wait_sim_time(1.0, 'the drive')
+    stack.release()
     assert stack.speed() > 0.2
     stack.kill('controller')
     # The sim keeps running on its lockstep timeout; its watchdog (0.5 s) stops the drive.
-    stack.wait_stopped(1.0, 'the car to stop without a controller')
+    stack.wait_stopped(1.0, 'the car to stop without a controller',
+                       since=stack.last_command_state)
     assert all(process.running() for process in stack.processes.values())
 
     count = len(stack.controller_states)
@@ -345,7 +478,9 @@ def test_killed_controller_stops_the_car_and_a_restart_recovers(stack: Stack):
 def test_killed_sim_mid_drive_and_a_new_sim_moves_only_on_a_new_cmd_vel(stack: Stack):
     # The old sim's clock well past the 2 s of the new one's watched here, so that their
     # messages tell apart by stamp.
-    stack.drive(0.3, max(1.0, 3.0 - stack.sim_time()))
+    stack.command(0.3)
+    stack.wait_sim_time(max(1.0, 3.0 - stack.sim_time()), 'the drive')
+    stack.release()
     assert stack.speed() > 0.2
     truth_count, state_count = len(stack.truth), len(stack.controller_states)
     stack.kill('sim')
@@ -406,10 +541,11 @@ def test_killed_odometry_and_planner_mid_drive_leave_cmd_vel_in_control(stack: S
 def test_killed_planner_mid_climb_stops_the_car_and_a_restart_recovers(stack: Stack):
     climb = stack.kill_mid_climb('planner')
     # The controller's swivel_command deadman (0.5 s) stops the drive.
-    stack.wait_stopped(1.2, 'the car to stop without a planner')
+    stack.wait_stopped(1.2, 'the car to stop without a planner',
+                       since=stack.last_swivel_command_heard)
     assert not climb.done()  # its server is gone; the client gives up on its own
     states = stack.controller_states
-    assert states[-1].source == 'hold' and states[-1].drive_speed == 0.0
+    assert states[-1].source != 'swivel_command' and states[-1].drive_speed == 0.0
     stack.climbs.remove(climb)
 
     stack.restart('planner')
@@ -439,7 +575,7 @@ def test_killed_odometry_mid_climb_ends_the_climb_and_a_restart_recovers(stack: 
     stack.spin_until(climb.done, 30.0, 'the climb to end without odometry')
     assert climb.result().error_code == ClimbStep.Response.ERROR_NOT_READY
     assert 'odom' in climb.result().message
-    stack.wait_stopped(1.0, 'the car to stop')
+    stack.wait_stopped(1.0, 'the car to stop', since=stack.last_swivel_command_heard)
 
     stack.restart('odometry')
     stack.wait_planner_ready()
@@ -462,10 +598,14 @@ def test_a_use_sim_time_flip_mid_drive_does_not_stretch_the_cmd_vel_deadman(stac
     try:
         use_sim_time(False)
         # The controller now stamps cmd_vel with wall time on receipt: it still obeys it...
-        stack.drive(0.3, 0.5)
+        stack.command(0.3)
+        stack.wait_sim_time(0.5, 'the drive')
         assert stack.speed() > 0.2, 'the flipped controller no longer obeys cmd_vel'
-        # ...and stops the car within its deadman once it no longer comes.
-        stack.wait_stopped(DEADMAN + BRAKING + 0.1, 'the car to stop after the flip')
+        # ...and stops the car within its deadman once it no longer comes: the last cmd_vel
+        # is unstamped, which the flipped controller stamps with the wall time on receipt.
+        last = stack.release()
+        stack.wait_stopped(DEADMAN + BRAKING + 0.1, 'the car to stop after the flip',
+                           since=lambda: last)
         stack.wait_sim_time(1.0, 'the car to stand')
         assert stack.speed() < 0.02
         use_sim_time(True)
@@ -489,8 +629,8 @@ def test_a_clock_far_ahead_stretches_no_deadman_and_every_node_survives_it(stack
     stack.call(stack.set_paused, SetBool.Request(data=False), 'sim/set_paused')
     start = stack.sim_time()
     stack.spin_until(lambda: stack.speed() > 0.1, 60.0, 'the held command to drive')
-    stack.spin_until(lambda: stack.speed() < 0.02, 60.0, 'the deadman to stop the car')
-    assert stack.sim_time() - start <= DEADMAN + BRAKING + 0.1, stack.sim_time() - start
+    stack.wait_stopped(DEADMAN + BRAKING + 0.1, 'the deadman to stop the car',
+                       since=lambda: start)
 
     # Every node went on (spin_until checks their processes): the odometry follows the
     # car, the planner takes requests, cmd_vel drives.
