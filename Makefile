@@ -4,6 +4,7 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 STAMP := $(VENV)/.requirements-installed
+BUILT := ros2_ws/install/.swivel_car_built
 IN_WS := scripts/in_ws
 PYTEST_ARGS ?=
 PYTEST_WORKERS ?= auto
@@ -27,12 +28,24 @@ $(STAMP): requirements.txt
 	    -r requirements.txt
 	cp requirements.txt $@
 
-build: setup
+build: $(BUILT)
+
+# The symlink install links each package's Python directory, so editing or adding a module
+# needs no build; what colcon installs otherwise (manifests, setup files, interfaces, config,
+# launch and resource files) does, and a build is then due. A build that changes nothing
+# still takes colcon 11 s.
+BUILD_INPUTS := $(shell find swivel_car_* -type f -not -path '*/__pycache__/*' \( \
+    -name package.xml -o -name setup.py -o -name setup.cfg -o -name CMakeLists.txt \
+    -o -path '*/msg/*' -o -path '*/srv/*' -o -path '*/action/*' -o -path '*/config/*' \
+    -o -path '*/launch/*' -o -path '*/resource/*' \))
+
+$(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	@echo '== building ros2_ws'
 	@# A file removed from a package leaves a dangling symlink that fails the symlink install.
 	-find ros2_ws/build ros2_ws/install -xtype l -delete 2>/dev/null
 	cd ros2_ws && ../$(IN_WS) colcon build --symlink-install --event-handlers console_cohesion- summary+ \
 	    --cmake-args -DBUILD_TESTING=OFF -DSWIVEL_CAR_MSGS_CPP=$(MSGS_CPP)
+	touch $@
 
 # Test files run side by side, one pytest-xdist worker per core (PYTEST_WORKERS=0: in one
 # process); each worker claims its own block of ROS domain ids. A file stays on one worker
