@@ -4,12 +4,12 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 STAMP := $(VENV)/.requirements-installed
-BUILT := ros2_ws/install/.swivel_car_built
+# The nodes are Python: the messages' C++ interfaces are built only on request (MSGS_CPP=ON).
+MSGS_CPP ?= OFF
+BUILT := ros2_ws/install/.swivel_car_built_msgs_cpp_$(MSGS_CPP)
 IN_WS := scripts/in_ws
 PYTEST_ARGS ?=
 PYTEST_WORKERS ?= auto
-# The nodes are Python: the messages' C++ interfaces are built only on request (MSGS_CPP=ON).
-MSGS_CPP ?= OFF
 
 .PHONY: setup build test demo figures bench soak clean
 
@@ -43,6 +43,7 @@ $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	@echo '== building ros2_ws'
 	@# A file removed from a package leaves a dangling symlink that fails the symlink install.
 	-find ros2_ws/build ros2_ws/install -xtype l -delete 2>/dev/null
+	rm -f ros2_ws/install/.swivel_car_built_*
 	cd ros2_ws && ../$(IN_WS) colcon build --symlink-install --event-handlers console_cohesion- summary+ \
 	    --cmake-args -DBUILD_TESTING=OFF -DSWIVEL_CAR_MSGS_CPP=$(MSGS_CPP)
 	touch $@
