@@ -95,6 +95,9 @@ class DriveTrain:
 
     def __init__(self, description: CarDescription, time_step: float) -> None:
         self.gains = DriveGains.for_robot(description.model_params(), time_step)
+        g = self.gains
+        self._gain_values = (g.speed_p, g.speed_i, g.shaft_stiffness, g.shaft_damping,
+                             g.lock_stiffness, g.lock_damping)
         self._rear_locked = description.rear_differential == 'locked'
         self._front_locked = description.front_differential == 'locked'
         self._time_step = time_step  # [s]
@@ -128,24 +131,26 @@ class DriveTrain:
 
         """
         # Every physics step: plain floats and the constants looked up once, since numpy on
-        # four numbers costs more than the physics step itself.
-        g = self.gains
+        # four numbers costs more than the physics step itself; the clamp is min/max's
+        # comparisons without the calls.
+        speed_p, speed_i, stiffness, damping, lock_stiffness, lock_damping = self._gain_values
         dt = self._time_step
         if stopped:
             swivel_torque, drive_speed = 0.0, 0.0
         rear_speed, front_speed = (rl[1] + rr[1]) / 2.0, (fl[1] + fr[1]) / 2.0
         error = drive_speed - rear_speed
         limit = self._torque_limit
-        unsaturated = g.speed_p * error + g.speed_i * (self._speed_integral + error * dt)
-        motor = min(limit, max(-limit, unsaturated))
+        unsaturated = speed_p * error + speed_i * (self._speed_integral + error * dt)
+        motor = unsaturated if unsaturated > -limit else -limit
+        motor = motor if motor < limit else limit
         if motor == unsaturated:
             self._speed_integral += error * dt
-        front = (g.shaft_stiffness * ((rl[0] + rr[0]) - (fl[0] + fr[0])) / 2.0
-                 + g.shaft_damping * (rear_speed - front_speed))
+        front = (stiffness * ((rl[0] + rr[0]) - (fl[0] + fr[0])) / 2.0
+                 + damping * (rear_speed - front_speed))
         rear = motor - front
-        rear_lock = (g.lock_stiffness * (rl[0] - rr[0]) + g.lock_damping * (rl[1] - rr[1])
+        rear_lock = (lock_stiffness * (rl[0] - rr[0]) + lock_damping * (rl[1] - rr[1])
                      if self._rear_locked else 0.0)
-        front_lock = (g.lock_stiffness * (fl[0] - fr[0]) + g.lock_damping * (fl[1] - fr[1])
+        front_lock = (lock_stiffness * (fl[0] - fr[0]) + lock_damping * (fl[1] - fr[1])
                       if self._front_locked else 0.0)
         return [swivel_torque, rear / 2.0 - rear_lock, rear / 2.0 + rear_lock,
                 front / 2.0 - front_lock, front / 2.0 + front_lock]

@@ -116,7 +116,7 @@ class SwivelCarSim:
         self.robot: RobotModel = build_robot(self.description, self.config.robot_variant,
                                              body_collision=self.config.body_collision)
         self._drive_train = DriveTrain(self.description, self.config.time_step)
-        # Read every physics step (_apply_actuators).
+        # Read by the watchdog every physics step.
         self._time_step = self.config.time_step  # [s]
         self._watchdog_timeout = self.config.watchdog_timeout  # [s]
         self._client = pybullet.connect(pybullet.GUI if self.config.gui else pybullet.DIRECT)
@@ -188,32 +188,41 @@ class SwivelCarSim:
     @property
     def watchdog_tripped(self) -> bool:
         """Whether the last command is older than the watchdog timeout."""
+        return self._tripped_at(self._steps)
+
+    def _tripped_at(self, steps: int) -> bool:
+        """Whether the watchdog is tripped after ``steps`` physics steps since construction."""
         timeout = self._watchdog_timeout
-        return timeout > 0.0 and self.time - self._command_time > timeout + 1e-9
+        return timeout > 0.0 and steps * self._time_step - self._command_time > timeout + 1e-9
 
     def step(self, steps: int = 1) -> None:
         """Advance the physics by ``steps`` time steps (1 .. 100000)."""
         if not isinstance(steps, int) or not 1 <= steps <= MAX_STEPS_PER_CALL:
             raise ValueError(f'steps must be an integer in [1, {MAX_STEPS_PER_CALL}], '
                              f'got {steps!r}')
-        v_start = self._base_velocity_world()[0]
-        for _ in range(steps):
-            self._apply_actuators()
-            pybullet.stepSimulation(physicsClientId=self._client)
-            self._steps += 1
-        v_end = self._base_velocity_world()[0]
-        span = steps * self.config.time_step  # [s]
-        self._acceleration = np.array([(end - start) / span
-                                       for start, end in zip(v_start, v_end)])
-
-    def _apply_actuators(self) -> None:
         # The hot loop (every physics step): direct pybullet calls, no numpy.
-        rl, rr, fl, fr = pybullet.getJointStates(self._body, self._wheel_ids,
-                                                 physicsClientId=self._client)
-        self._efforts = self._drive_train.efforts(rl, rr, fl, fr, self._swivel_torque,
-                                                  self._drive_speed, self.watchdog_tripped)
-        pybullet.setJointMotorControlArray(self._body, self._joint_ids, pybullet.TORQUE_CONTROL,
-                                           forces=self._efforts, physicsClientId=self._client)
+        v_start = self._base_now()[2]
+        body, client, joint_ids, wheel_ids = (self._body, self._client, self._joint_ids,
+                                              self._wheel_ids)
+        efforts = self._drive_train.efforts
+        joint_states = self._joint_states
+        self._joint_states = self._base = None
+        # Sim time only grows, so a watchdog not tripped at the last step is not at any.
+        may_trip = self._tripped_at(self._steps + steps - 1)
+        for _ in range(steps):
+            rl, rr, fl, fr = (joint_states[1:] if joint_states is not None else
+                              pybullet.getJointStates(body, wheel_ids, physicsClientId=client))
+            joint_states = None
+            self._efforts = efforts(rl, rr, fl, fr, self._swivel_torque, self._drive_speed,
+                                    may_trip and self.watchdog_tripped)
+            pybullet.setJointMotorControlArray(body, joint_ids, pybullet.TORQUE_CONTROL,
+                                               forces=self._efforts, physicsClientId=client)
+            pybullet.stepSimulation(physicsClientId=client)
+            self._steps += 1
+        v_end = self._base_now()[2]
+        span = steps * self.config.time_step  # [s]
+        self._acceleration = ((v_end[0] - v_start[0]) / span, (v_end[1] - v_start[1]) / span,
+                              (v_end[2] - v_start[2]) / span)
 
     # --- robot -----------------------------------------------------------------------------
 
@@ -270,46 +279,66 @@ class SwivelCarSim:
         self._command_time = self.time
         self._drive_train.reset()
         self._efforts = [0.0] * len(self._joint_ids)
-        self._acceleration = np.zeros(3)
+        self._acceleration = (0.0, 0.0, 0.0)  # [m/s^2] of base_link, world, over the last step
+        self._forget_motion()
+
+    def _forget_motion(self) -> None:
+        """Drop what was read of the robot's motion: it moved other than by ``step``."""
+        # Each read is a pybullet request (2-3 us): the pose and velocity read at the end of a
+        # step serve the next step and state(); the joint states state() reads serve the
+        # next step's first drive train torques.
+        self._base: tuple[tuple[float, ...], ...] | None = None
+        self._joint_states: tuple | None = None
 
     def _base_pose(self) -> tuple[np.ndarray, np.ndarray]:
-        """base_link origin and orientation (pybullet reports the base's inertial frame)."""
-        com_pos, com_orn = self._pb.getBasePositionAndOrientation(self._body)
-        pos, orn = pybullet.multiplyTransforms(com_pos, com_orn, *self._link_in_com)
+        """base_link origin and orientation."""
+        pos, orn, _, _ = self._base_now()
         return np.array(pos), np.array(orn)
 
-    def _base_velocity_world(self) -> tuple[tuple[float, float, float],
-                                            tuple[float, float, float]]:
+    def _base_now(self) -> tuple[tuple[float, ...], ...]:
         """
-        Return base_link's origin velocity and angular velocity in the world frame.
+        Return base_link's origin, orientation, origin velocity, angular velocity now.
 
-        As floats: it runs twice per ``step``.
+        In the world frame, as floats, read from pybullet once per physics state (pybullet
+        reports the base's inertial frame).
         """
-        client = self._client
-        com_pos, com_orn = pybullet.getBasePositionAndOrientation(self._body,
-                                                                  physicsClientId=client)
-        linear, angular = pybullet.getBaseVelocity(self._body, physicsClientId=client)
-        pos, _ = pybullet.multiplyTransforms(com_pos, com_orn, *self._link_in_com)
-        # v_origin = v_com + omega x (origin - com)
-        dx, dy, dz = pos[0] - com_pos[0], pos[1] - com_pos[1], pos[2] - com_pos[2]
-        wx, wy, wz = angular
-        return ((linear[0] + wy * dz - wz * dy, linear[1] + wz * dx - wx * dz,
-                 linear[2] + wx * dy - wy * dx), angular)
+        if self._base is None:
+            client = self._client
+            com_pos, com_orn = pybullet.getBasePositionAndOrientation(self._body,
+                                                                      physicsClientId=client)
+            linear, angular = pybullet.getBaseVelocity(self._body, physicsClientId=client)
+            pos, orn = pybullet.multiplyTransforms(com_pos, com_orn, *self._link_in_com)
+            # v_origin = v_com + omega x (origin - com)
+            dx, dy, dz = pos[0] - com_pos[0], pos[1] - com_pos[1], pos[2] - com_pos[2]
+            wx, wy, wz = angular
+            self._base = (pos, orn, (linear[0] + wy * dz - wz * dy, linear[1] + wz * dx - wx * dz,
+                                     linear[2] + wx * dy - wy * dx), angular)
+        return self._base
 
     def state(self) -> RobotState:
         """Return the sensors and the ground truth now."""
-        states = self._pb.getJointStates(self._body, self._joint_ids)
-        pos, orn = self._base_pose()
-        rotation = np.array(pybullet.getMatrixFromQuaternion(orn)).reshape(3, 3)
-        linear, angular = (np.array(v) for v in self._base_velocity_world())
-        specific_force = self._acceleration + np.array([0.0, 0.0, GRAVITY])
+        if self._joint_states is None:
+            self._joint_states = pybullet.getJointStates(self._body, self._joint_ids,
+                                                         physicsClientId=self._client)
+        states = self._joint_states
+        pos, orn, linear, angular = self._base_now()
+        r = pybullet.getMatrixFromQuaternion(orn)
+        ax, ay, az = self._acceleration
+
+        def in_base(x: float, y: float, z: float) -> np.ndarray:
+            # R^T (x, y, z) summed as numpy's R.T @ v sums it (from +0.0, left to right):
+            # the same bits without numpy's cost per call on three numbers.
+            return np.array((0.0 + r[0] * x + r[3] * y + r[6] * z,
+                             0.0 + r[1] * x + r[4] * y + r[7] * z,
+                             0.0 + r[2] * x + r[5] * y + r[8] * z))
+
         return RobotState(
             time=self.time, joint_names=self.joint_names,
             positions=np.array([s[0] for s in states]),
             velocities=np.array([s[1] for s in states]),
-            efforts=np.array(self._efforts), position=pos, orientation=orn,
-            linear_velocity=rotation.T @ linear, angular_velocity=rotation.T @ angular,
-            linear_acceleration=rotation.T @ specific_force)
+            efforts=np.array(self._efforts), position=np.array(pos), orientation=np.array(orn),
+            linear_velocity=in_base(*linear), angular_velocity=in_base(*angular),
+            linear_acceleration=in_base(ax, ay, az + GRAVITY))
 
     def wheel_lowest_points(self) -> np.ndarray:
         """
@@ -356,6 +385,7 @@ class SwivelCarSim:
         """
         com_pos, com_orn = pybullet.multiplyTransforms(
             list(position), list(orientation), *self._com_in_link)
+        self._forget_motion()
         self._pb.resetBasePositionAndOrientation(self._body, com_pos, com_orn)
         for name, joint in zip(self.joint_names, self._joint_ids):
             if name in joint_positions:

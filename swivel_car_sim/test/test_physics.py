@@ -224,6 +224,27 @@ def test_same_inputs_give_the_same_states():
     np.testing.assert_array_equal(a.orientation, b.orientation)
 
 
+def test_reading_the_state_changes_nothing_and_a_move_shows_at_once():
+    # The sim reuses what it read of the robot until the robot moves (physics.py).
+    fields = ('positions', 'velocities', 'efforts', 'position', 'orientation',
+              'linear_velocity', 'angular_velocity', 'linear_acceleration')
+    with SwivelCarSim() as reader, SwivelCarSim() as other:
+        for i in range(40):
+            for s in (reader, other):
+                s.set_command(10.0 * math.sin(i / 5.0), 8.0)
+                s.step(5)
+            reader.state()
+        a, b = reader.state(), other.state()
+        for name in fields:
+            assert getattr(a, name).tobytes() == getattr(b, name).tobytes(), name
+        assert a.velocities[1] > 5.0  # driving: show_state's reset of the wheel shows below
+        reader.show_state(a.position + [0.0, 0.0, 0.01], a.orientation,
+                          {a.joint_names[1]: 0.2})
+        shown = reader.state()
+        assert shown.position[2] == pytest.approx(a.position[2] + 0.01, abs=1e-6)
+        assert (shown.positions[1], shown.velocities[1]) == (pytest.approx(0.2), 0.0)
+
+
 def test_non_finite_command_is_refused_and_the_previous_one_stays(sim):
     sim.set_command(1.0, 2.0)
     for bad in ((math.nan, 0.0), (0.0, math.inf)):
