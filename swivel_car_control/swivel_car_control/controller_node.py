@@ -7,7 +7,6 @@ One ActuatorCommand per joint_states message (the lockstep protocol of docs/arch
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
 import math
 import sys
 import time
@@ -23,37 +22,14 @@ from swivel_car_control.core.controller import ControllerConfig, SwivelControlle
 from swivel_car_control.core.joint_states import JointStateController
 from swivel_car_control.joints import MissingJointError
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
+from swivel_car_ros.lockstep import ChainedAnswers, stamp_ns
 from swivel_car_ros.ros_params import (
-    declare_dataclass, declare_description, is_zero_stamp, live_parameters, moment_seconds,
-    run_node, stamp_to_seconds)
+    declare_dataclass, declare_description, is_zero_stamp, live_parameters, run_node,
+    stamp_to_seconds, STATE_QUEUE_DEPTH)
 
 # A cmd_vel stamped further than this ahead of the node clock is taken as arriving now.
 _CLOCK_SLACK = 0.5  # [s]
-
-
-@dataclass
-class _ChainedSource:
-    """A command stream the controller waits for in lockstep (docs/architecture.md)."""
-
-    name: str  # its topic
-    enabled: bool  # the lockstep_* parameter
-    heard: TimeMsg = field(default_factory=TimeMsg)  # its last stamped command (zero: none)
-    chained: bool = False  # the command in force came stamped: it takes part in the chain
-    late: bool = False  # missed a wait: not waited for until its next stamped command
-
-    def hear(self, stamp: TimeMsg) -> None:
-        """Take a command's stamp; a stamped one answers its cycle, refused or not."""
-        if not is_zero_stamp(stamp):
-            self.heard, self.late = stamp, False
-
-    def awaited(self, last_time: float) -> bool:
-        """Tell whether its answer to the state of ``last_time`` [s] is still to come."""
-        return (self.enabled and self.chained and not self.late
-                and last_time > moment_seconds(self.heard))
-
-    def forget(self) -> None:
-        """Drop what was heard: a sim reset's new world."""
-        self.heard, self.chained = TimeMsg(), False
+_NO_STAMP = TimeMsg()  # a source's stamp in the controller state while none was heard
 
 
 CONFIG_DESCRIPTIONS = {
@@ -126,10 +102,10 @@ class ControllerNode(Node):
                         self._core.reconfigure)
         self._joint_states = JointStateController(self._core, swivel_joint)
         self._warned_zero_stamp = False
-        self._planner = _ChainedSource('swivel_command', self._lockstep_swivel_command)
-        self._driver = _ChainedSource('cmd_vel', self._lockstep_cmd_vel)
-        self._pending: JointState | None = None  # joint_states waiting for their commands
-        self._pending_since = 0.0  # [s] wall
+        # When to answer a joint_states in the lockstep chain: docs/architecture.md.
+        self._chain: ChainedAnswers[JointState] = ChainedAnswers(
+            round(self._lockstep_wait * 1e9), self._lockstep_swivel_command,
+            self._lockstep_cmd_vel)
 
         # Built once, refilled every period: a message constructor imports and builds each
         # nested message in Python, every time.
@@ -137,8 +113,10 @@ class ControllerNode(Node):
         self._state = SwivelControllerState()
         self._limited = TwistStamped()
         self._limited.header.frame_id = self._base_frame_id
-        self._command_pub = self.create_publisher(ActuatorCommand, 'actuator_command', 10)
-        self._state_pub = self.create_publisher(SwivelControllerState, '~/controller_state', 10)
+        self._command_pub = self.create_publisher(ActuatorCommand, 'actuator_command',
+                                                  STATE_QUEUE_DEPTH)
+        self._state_pub = self.create_publisher(SwivelControllerState, '~/controller_state',
+                                                STATE_QUEUE_DEPTH)
         self._cmd_out_pub = self.create_publisher(TwistStamped, '~/cmd_vel_out', 10)
         self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
         self.create_subscription(TwistStamped if self._use_stamped else Twist, 'cmd_vel',
@@ -188,22 +166,23 @@ class ControllerNode(Node):
     def _on_cmd_vel(self, msg: TwistStamped | Twist) -> None:
         if isinstance(msg, TwistStamped):
             twist = msg.twist
-            stamp = self._cmd_vel_time(msg.header.stamp)
-            self._driver.hear(msg.header.stamp)
-            self._driver.chained = not is_zero_stamp(msg.header.stamp)
+            header_stamp = msg.header.stamp
+            stamp = self._cmd_vel_time(header_stamp)
         else:
             twist = msg
+            header_stamp = _NO_STAMP
             stamp = self._now()
-            self._driver.chained = False
         try:
             self._core.set_cmd_vel(twist.linear.x, twist.angular.z, stamp)
         except ValueError as error:
             self.get_logger().warn(str(error))
-        self._answer_pending()
+        # In the chain or out of it, whether the core took it or not.
+        self._answer(self._chain.heard(self._chain.driver, stamp_ns(header_stamp), True,
+                                       self._holding(), header_stamp))
 
     def _on_swivel_command(self, msg: SwivelCommand) -> None:
-        held_before = self._core.swivel_command is not None
-        self._planner.hear(msg.header.stamp)
+        held_before = self._holding()
+        applied = False
         try:
             # The deadman counts from receipt: a planner that lags behind a lockstep sim
             # running ahead of it (before its first command held the sim back) is not dead.
@@ -212,18 +191,19 @@ class ControllerNode(Node):
         except ValueError as error:
             self.get_logger().error(str(error), throttle_duration_sec=1.0)
         else:
-            self._planner.chained = not is_zero_stamp(msg.header.stamp)
+            applied = True
             if msg.hold and not held_before:
                 self.get_logger().info(
                     f'swivel_command takes over: angle {msg.angle:.3f} rad, drive '
                     f'{msg.drive_speed:.3f} rad/s')
             elif held_before and not msg.hold:
                 self.get_logger().info('swivel_command released: cmd_vel steers again')
-        self._answer_pending()
+        self._answer(self._chain.heard(self._chain.planner, stamp_ns(msg.header.stamp),
+                                       applied, self._holding(), msg.header.stamp))
 
-    def _answer_pending(self) -> None:
-        if self._pending is not None and not self._awaited(self._pending):
-            self._answer(self._take_pending())
+    def _holding(self) -> bool:
+        """Tell whether a swivel_command is held: the planner's next one is awaited."""
+        return self._core.swivel_command is not None
 
     def _on_sim_reset(self, msg: Header) -> None:
         t = stamp_to_seconds(msg.stamp)
@@ -233,58 +213,29 @@ class ControllerNode(Node):
             self.get_logger().warn(f'ignoring sim/reset_event: {error}',
                                    throttle_duration_sec=1.0)
             return
-        if self._pending is not None and stamp_to_seconds(self._pending.header.stamp) < t:
-            self._pending = None  # a state of the old world: the sim waits for it no more
-        self._planner.forget()
-        self._driver.forget()
+        self._chain.forget(stamp_ns(msg.stamp))
         self.get_logger().info(f'the sim was reset at {t:.3f} s: commands dropped, the swivel '
                                'held where it is measured then, drive stopped, until a new '
                                'command')
 
-    def _awaited(self, msg: JointState) -> list[_ChainedSource]:
-        """
-        List the sources whose commands ``msg`` waits for: answers to the previous state.
-
-        In lockstep, a stamped swivel_command held (the planner's pipeline is one cycle deep)
-        and a stamped cmd_vel (a driver in the chain), each until it is late once.
-        """
-        last_time = self._joint_states.last_time  # [s] of the last joint_states answered
-        if last_time is None or stamp_to_seconds(msg.header.stamp) <= last_time:
-            return []
-        sources = [self._driver]
-        if self._core.swivel_command is not None:  # released or timed out: nothing to wait for
-            sources.insert(0, self._planner)
-        return [source for source in sources if source.awaited(last_time)]
-
-    def _take_pending(self) -> JointState:
-        msg, self._pending = self._pending, None
-        return msg
-
     def _on_wait_timer(self) -> None:
-        if (self._pending is not None
-                and time.monotonic() - self._pending_since > self._lockstep_wait):
-            awaited = self._awaited(self._pending)
-            if awaited:
-                names = ' or '.join(source.name for source in awaited)
-                self.get_logger().warn(
-                    f'no {names} answered the last state within lockstep_wait '
-                    f'{self._lockstep_wait} s: going on without it until the next one comes '
-                    '(the run is no longer deterministic)', throttle_duration_sec=5.0)
-            for source in awaited:
-                source.late = True
-            self._answer(self._take_pending())
-
-    def _on_joint_states(self, msg: JointState) -> None:
-        if self._awaited(msg):
-            if self._pending is None or self._pending.header.stamp != msg.header.stamp:
-                self._pending_since = time.monotonic()
-            self._pending = msg
-            return
-        self._pending = None
+        msg, late = self._chain.tick(self._holding(), time.monotonic_ns())
+        if late:
+            names = ' or '.join(source.name for source in late)
+            self.get_logger().warn(
+                f'no {names} answered the last state within lockstep_wait '
+                f'{self._lockstep_wait} s: going on without it until the next one comes '
+                '(the run is no longer deterministic)', throttle_duration_sec=5.0)
         self._answer(msg)
 
-    def _answer(self, msg: JointState) -> None:
-        """One ActuatorCommand (and controller state) for this joint_states."""
+    def _on_joint_states(self, msg: JointState) -> None:
+        self._answer(self._chain.state(stamp_ns(msg.header.stamp), msg, self._holding(),
+                                       time.monotonic_ns()))
+
+    def _answer(self, msg: JointState | None) -> None:
+        """One ActuatorCommand (and controller state) for this joint_states; None: none."""
+        if msg is None:
+            return
         stamp = msg.header.stamp
         command = self._command
         command.header.stamp = stamp
@@ -322,9 +273,12 @@ class ControllerNode(Node):
         state.saturated = out.pid.saturated
         state.drive_speed = out.drive_speed
         state.source = out.source
-        state.swivel_command_stamp = self._planner.heard
-        state.cmd_vel_stamp = self._driver.heard
+        planner, driver = self._chain.planner, self._chain.driver
+        state.swivel_command_stamp = (_NO_STAMP if planner.heard_stamp is None
+                                      else planner.heard_stamp)
+        state.cmd_vel_stamp = _NO_STAMP if driver.heard_stamp is None else driver.heard_stamp
         self._state_pub.publish(state)
+        self._chain.answered(stamp_ns(stamp))
 
         # A diagnostic: published only to a listener (a recorder that subscribes gets it).
         if self._cmd_out_pub.get_subscription_count():

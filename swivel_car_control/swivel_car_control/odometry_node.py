@@ -125,7 +125,7 @@ class OdometryNode(Node):
 
         self._apply_config(config)
         live_parameters(self, OdometryConfig.LIVE, self._live_config, self._apply_config)
-        self._odom_pub = self.create_publisher(Odometry, 'odom', 10)
+        self._odom_pub = self.create_publisher(Odometry, 'odom', STATE_QUEUE_DEPTH)
         # Outside the lockstep chain the odometry may trail a busy sim: a second of states
         # queued, so it integrates every one instead of dropping them and Euler-stepping the
         # gap with the last rates.

@@ -220,73 +220,94 @@ def stamped_swivel_command(t, angle, hold=True):
     return msg
 
 
-def test_lockstep_waits_for_the_planners_command_of_the_previous_state():
-    harness = Harness(ControllerNode, {'lockstep_swivel_command': True, 'lockstep_wait': 3.0})
-    try:
-        commands = harness.record(ActuatorCommand, 'actuator_command')
-        states = harness.record(SwivelControllerState, 'controller/controller_state')
+class PlannerChain:
+    """A controller chained to a planner (the probe's stamped swivel_command)."""
+
+    def __init__(self, lockstep_wait):
+        self.harness = harness = Harness(ControllerNode, {
+            'lockstep_swivel_command': True, 'lockstep_wait': lockstep_wait})
+        self.commands = harness.record(ActuatorCommand, 'actuator_command')
+        self.states = harness.record(SwivelControllerState, 'controller/controller_state')
         harness.joints = harness.probe.create_publisher(JointState, 'joint_states', 10)
-        swivel = harness.probe.create_publisher(SwivelCommand, 'swivel_command', 10)
-        for publisher in (harness.joints, swivel):
+        self.swivel = harness.probe.create_publisher(SwivelCommand, 'swivel_command', 10)
+        for publisher in (harness.joints, self.swivel):
             harness.wait_connected(publisher)
         spin_until(harness.executor, lambda: all(
             harness.probe.count_publishers(topic) for topic in harness.received), 10.0,
             'publishers')
 
-        def state_of(t, timeout=10.0):
-            stamp = joint_state(t).header.stamp
-            spin_until(harness.executor, lambda: states and states[-1].header.stamp == stamp,
-                       timeout, f'the state of {t}')
-            return states[-1]
+    def state_of(self, t, timeout=10.0):
+        stamp = joint_state(t).header.stamp
+        states = self.states
+        spin_until(self.harness.executor,
+                   lambda: states and states[-1].header.stamp == stamp, timeout,
+                   f'the state of {t}')
+        return states[-1]
 
+    def spin(self):
+        """Spin long enough for a message to arrive, as nothing else shows it (0.2 s)."""
+        for _ in range(20):
+            self.harness.executor.spin_once(timeout_sec=0.01)
+
+
+def test_lockstep_waits_for_the_planners_command_of_the_previous_state():
+    chain = PlannerChain(lockstep_wait=3.0)  # never reached: the planner always answers
+    harness, states = chain.harness, chain.states
+    try:
         step(harness, 1.0)  # nothing held: no wait
-        swivel.publish(stamped_swivel_command(1.0, 0.3))
-        for _ in range(20):  # the first command is taken whenever it comes
-            harness.executor.spin_once(timeout_sec=0.01)
+        chain.swivel.publish(stamped_swivel_command(1.0, 0.3))
+        chain.spin()  # the first command is taken whenever it comes
         step(harness, 1.01)
-        state = state_of(1.01)
+        state = chain.state_of(1.01)
         assert state.target == pytest.approx(0.3)
         # It says which command it heard: the planner's sign that the chain holds.
         assert state.swivel_command_stamp == joint_state(1.0).header.stamp
 
         # The command answering 1.01 has not come: 1.02 waits for it, then takes it.
         harness.joints.publish(joint_state(1.02))
-        for _ in range(20):
-            harness.executor.spin_once(timeout_sec=0.01)
-        assert commands[-1].header.stamp == joint_state(1.01).header.stamp
-        swivel.publish(stamped_swivel_command(1.01, 0.4))
-        assert state_of(1.02).target == pytest.approx(0.4)
+        chain.spin()
+        assert chain.commands[-1].header.stamp == joint_state(1.01).header.stamp
+        chain.swivel.publish(stamped_swivel_command(1.01, 0.4))
+        assert chain.state_of(1.02).target == pytest.approx(0.4)
 
-        # A planner that does not answer: after lockstep_wait the controller goes on, and
-        # waits no more until the next command.
+        # A release ends the wait.
         harness.joints.publish(joint_state(1.03))
-        assert state_of(1.03, 10.0).target == pytest.approx(0.4)
-        step(harness, 1.04)
-
-        # The next command re-arms the wait; a release ends it.
-        swivel.publish(stamped_swivel_command(1.04, 0.5))
-        for _ in range(20):
-            harness.executor.spin_once(timeout_sec=0.01)
-        harness.joints.publish(joint_state(1.05))
-        assert state_of(1.05).target == pytest.approx(0.5)
-        harness.joints.publish(joint_state(1.06))
-        for _ in range(20):
-            harness.executor.spin_once(timeout_sec=0.01)
-        assert states[-1].header.stamp == joint_state(1.05).header.stamp
-        swivel.publish(stamped_swivel_command(1.05, 0.0, hold=False))
-        assert state_of(1.06).source == 'hold'
-        step(harness, 1.07)  # released: no wait
+        chain.spin()
+        assert states[-1].header.stamp == joint_state(1.02).header.stamp
+        chain.swivel.publish(stamped_swivel_command(1.02, 0.0, hold=False))
+        assert chain.state_of(1.03).source == 'hold'
+        step(harness, 1.04)  # released: no wait
 
         # A command with a zero stamp (a hand-made one, not the planner's) is held without
         # any wait.
-        swivel.publish(SwivelCommand(angle=0.2, hold=True))
-        for _ in range(20):
-            harness.executor.spin_once(timeout_sec=0.01)
-        for t in (1.08, 1.09):
+        chain.swivel.publish(SwivelCommand(angle=0.2, hold=True))
+        chain.spin()
+        for t in (1.05, 1.06):
             harness.joints.publish(joint_state(t))
-            state = state_of(t, 1.5)  # well within lockstep_wait: no wait
+            state = chain.state_of(t, 1.5)  # well within lockstep_wait: no wait
         assert state.target == pytest.approx(0.2)
-        assert state.swivel_command_stamp == joint_state(1.05).header.stamp  # zero: not one
+        assert state.swivel_command_stamp == joint_state(1.02).header.stamp  # zero: not one
+    finally:
+        harness.close()
+
+
+def test_after_lockstep_wait_the_controller_answers_without_the_planners_command():
+    chain = PlannerChain(lockstep_wait=0.1)
+    harness = chain.harness
+    try:
+        step(harness, 1.0)
+        chain.swivel.publish(stamped_swivel_command(1.0, 0.3))
+        chain.spin()
+        step(harness, 1.01)
+        # No answer to 1.01: 1.02 is answered after lockstep_wait, with the command in force.
+        step(harness, 1.02)
+        assert chain.state_of(1.02).target == pytest.approx(0.3)
+        # The planner's next command is taken again (the wait it re-arms: test_lockstep.py).
+        chain.swivel.publish(stamped_swivel_command(1.02, 0.5))
+        chain.spin()
+        harness.joints.publish(joint_state(1.03))
+        assert chain.state_of(1.03).target == pytest.approx(0.5)
+        assert chain.state_of(1.03).swivel_command_stamp == joint_state(1.02).header.stamp
     finally:
         harness.close()
 

@@ -25,10 +25,13 @@ from swivel_car_model.description import CarDescription
 
 T = TypeVar('T')
 
-# joint_states kept on both ends (publisher history, subscription queue), so that a node outside
-# the lockstep chain (the odometry) that lags behind an unpaced sim skips no state: 1 s of the
-# default control period. With 10 s, one full test run had whole-stack tests stall on service
-# calls (cause not found; Fast DDS keeps a writer's history in a 512 KiB shared-memory segment).
+# State messages kept on both ends (publisher history, subscription queue): joint_states, so
+# that a node outside the lockstep chain (the odometry) that lags behind an unpaced sim skips no
+# state, and what a recorder or a test watches (ground truth, odom, actuator commands,
+# controller states: a test's recorder under load once missed 22 ground truths in a row, with
+# 10 kept): 1 s of the default control period. With 10 s, one full test run had whole-stack
+# tests stall on service calls (cause not found; Fast DDS keeps a writer's history in a 512 KiB
+# shared-memory segment).
 STATE_QUEUE_DEPTH = 100
 
 

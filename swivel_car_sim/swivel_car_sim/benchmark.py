@@ -38,6 +38,7 @@ from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
+from std_srvs.srv import SetBool
 
 from swivel_car_sim.physics import SwivelCarSim
 from swivel_car_sim.sim_node import SimNode
@@ -130,7 +131,7 @@ def node_rtf(seconds: float, listener: bool) -> tuple[float, float]:
         while (listener and any(sim.count_subscribers(topic) == 0 for _, topic in TOPICS)
                and time.perf_counter() < deadline):
             executor.spin_once(timeout_sec=0.05)
-        sim._paused = False
+        sim._on_set_paused(SetBool.Request(data=False), SetBool.Response())  # ~/set_paused
         start_time, start, cpu = sim.sim.time, time.perf_counter(), time.process_time()
         while time.perf_counter() - start < seconds:
             executor.spin_once(timeout_sec=0.1)

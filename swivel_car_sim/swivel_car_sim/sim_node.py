@@ -20,6 +20,7 @@ from std_srvs.srv import SetBool
 from swivel_car_msgs.msg import ActuatorCommand
 from swivel_car_msgs.srv import (RemoveObstacle, ResetSimulation, SpawnObstacle,
                                  StepSimulation)
+from swivel_car_ros.lockstep import SimLockstep, stamp_ns
 from swivel_car_ros.ros_params import run_node, STATE_QUEUE_DEPTH
 from swivel_car_sim.config import PARAMETERS, SimNodeConfig
 from swivel_car_sim.conversions import sim_time, sim_time_msg, StateMessages
@@ -29,9 +30,6 @@ from swivel_car_sim.world import StepSpec
 # With real_time_factor 0 one timer callback steps for at most this long, then yields to
 # the executor so that commands and service calls are never starved.
 FAST_BATCH_WALL_TIME = 0.005  # [s]
-# In lockstep the state is published again while no command comes, so that a controller
-# started after the sim (or a lost message) still gets the state it must answer.
-LOCKSTEP_REPUBLISH_PERIOD = 0.1  # [s] wall
 
 
 class SimNode(Node):
@@ -52,22 +50,19 @@ class SimNode(Node):
         cfg = self.config
         self.sim = SwivelCarSim(cfg.physics, cfg.initial_pose)
         self._time_step_ns = round(cfg.physics.time_step * 1e9)
-        self._paused = cfg.start_paused
-        self._command_ready = False
-        # Lockstep with no command for lockstep_timeout: the controller is taken for gone and
-        # the sim runs at real time (its watchdog stopping the car) until a command comes.
-        self._unanswered = False
+        # When to advance (lockstep and pause): docs/architecture.md.
+        self._lockstep = SimLockstep(
+            round(cfg.control_period * 1e9), round(cfg.lockstep_timeout * 1e9),
+            cfg.lockstep_real_time_factor, cfg.start_paused, time.monotonic_ns())
         self._periods = 0
-        self._period_start_wall = self._last_publish_wall = time.monotonic()
-        self._next_due_wall = self._period_start_wall  # [s] steady clock of the next paced advance
         self._messages = StateMessages(self.sim.joint_names, cfg.world_frame_id,
                                        cfg.base_frame_id)
-        self._reset_ns = 0  # [ns] sim time of the first state after the last ~/reset
 
         self._clock_pub = self.create_publisher(ClockMsg, '/clock', 10)
         self._joint_pub = self.create_publisher(JointState, 'joint_states', STATE_QUEUE_DEPTH)
         self._imu_pub = self.create_publisher(Imu, 'imu', 10)
-        self._odom_pub = self.create_publisher(Odometry, 'ground_truth/odom', 10)
+        self._odom_pub = self.create_publisher(Odometry, 'ground_truth/odom',
+                                               STATE_QUEUE_DEPTH)
         self._reset_pub = self.create_publisher(Header, '~/reset_event', 10)
         self.create_subscription(ActuatorCommand, 'actuator_command', self._on_command, 10)
         self.create_service(ResetSimulation, '~/reset', self._on_reset)
@@ -77,14 +72,9 @@ class SimNode(Node):
         self.create_service(RemoveObstacle, '~/remove_obstacle', self._on_remove)
 
         wall = Clock(clock_type=ClockType.STEADY_TIME)
-        # Wall time a lockstep period must at least take (0: none).
-        self._lockstep_min_wall = (cfg.control_period / cfg.lockstep_real_time_factor
-                                   if cfg.lockstep_real_time_factor > 0.0 else 0.0)
         if cfg.lockstep:
-            period = 0.02 if cfg.lockstep_timeout == 0.0 else min(0.02, cfg.lockstep_timeout / 4)
-            if self._lockstep_min_wall > 0.0:
-                period = min(period, self._lockstep_min_wall / 2.0)
-            self.create_timer(period, self._on_lockstep_timer, clock=wall)
+            self.create_timer(self._lockstep.tick_period_ns * 1e-9, self._on_lockstep_timer,
+                              clock=wall)
         elif cfg.real_time_factor > 0.0:
             self.create_timer(cfg.control_period / cfg.real_time_factor, self._advance_if_running,
                               clock=wall)
@@ -95,7 +85,7 @@ class SimNode(Node):
             f'{cfg.physics.robot_variant} car, time_step {cfg.physics.time_step} s, control '
             f'period {cfg.control_period} s, '
             + ('lockstep' if cfg.lockstep else f'real_time_factor {cfg.real_time_factor}')
-            + (', paused' if self._paused else ''))
+            + (', paused' if self._lockstep.paused else ''))
 
     def destroy_node(self) -> None:
         self.sim.close()
@@ -108,54 +98,36 @@ class SimNode(Node):
 
     def _advance(self) -> None:
         """One control period of physics, then publish the new state."""
-        self._command_ready = False
         self.sim.step(self.config.steps_per_period)
         self._periods += 1
-        now = time.monotonic()
-        self._period_start_wall = now
-        # The pace keeps an absolute schedule, so the timer's lag does not add up period by
-        # period (it did: 0.67x at a pace of 1x); a sim behind it restarts it, never ahead.
-        due = self._next_due_wall + self._lockstep_min_wall
-        self._next_due_wall = due if due >= now else now + self._lockstep_min_wall
-        self._publish_state()
+        now = time.monotonic_ns()  # [ns]
+        self._lockstep.advanced(self._publish_messages(), now)
 
     def _advance_if_running(self) -> None:
-        if not self._paused:
+        if not self._lockstep.paused:
             self._advance()
 
     def _on_fast_timer(self) -> None:
         deadline = time.monotonic() + FAST_BATCH_WALL_TIME
-        while not self._paused and time.monotonic() < deadline:
-            self._advance()
-
-    def _advance_when_due(self) -> None:
-        """Lockstep: advance on the awaited command, but not faster than the pace cap."""
-        if time.monotonic() >= self._next_due_wall:
+        while not self._lockstep.paused and time.monotonic() < deadline:
             self._advance()
 
     def _on_lockstep_timer(self) -> None:
-        if self._paused:
-            return
-        if self._command_ready:
-            self._advance_when_due()
-            return
-        now = time.monotonic()
-        timeout = self.config.lockstep_timeout
-        if self._unanswered:
-            # The periods due since the last advance: real time on average, whatever the
-            # timer's period.
-            for _ in range(int((now - self._period_start_wall) / self.config.control_period)):
-                self._advance()
-        elif timeout > 0.0 and now - self._period_start_wall > timeout:
+        tick = self._lockstep.tick(time.monotonic_ns())
+        if tick.timed_out:
             self.get_logger().warn(
-                f'lockstep: no actuator_command for {timeout} s: advancing at real time '
-                'without one until one comes', throttle_duration_sec=5.0)
-            self._unanswered = True
+                f'lockstep: no actuator_command for {self.config.lockstep_timeout} s: advancing '
+                'at real time without one until one comes', throttle_duration_sec=5.0)
+        for _ in range(tick.periods):
             self._advance()
-        elif now - self._last_publish_wall > LOCKSTEP_REPUBLISH_PERIOD:
+        if tick.republish:
             self._publish_state()
 
     def _publish_state(self) -> None:
+        self._lockstep.published(self._publish_messages(), time.monotonic_ns())
+
+    def _publish_messages(self) -> int:
+        """Publish the current state; return its stamp [ns]."""
         messages = self._messages
         state = self.sim.state()
         sec, nanosec = sim_time(self.sim.steps, self._time_step_ns)
@@ -169,14 +141,13 @@ class SimNode(Node):
         if (self._periods % self.config.ground_truth_every == 0
                 and self._odom_pub.get_subscription_count()):
             self._odom_pub.publish(messages.odometry(state, sec, nanosec))
-        self._last_publish_wall = time.monotonic()
+        return sec * 1_000_000_000 + nanosec
 
     # --- callbacks -------------------------------------------------------------------------
 
     def _on_command(self, msg: ActuatorCommand) -> None:
-        stamp = msg.header.stamp
-        computed = stamp.sec * 1_000_000_000 + stamp.nanosec  # [ns]
-        if 0 < computed < self._reset_ns:
+        computed = stamp_ns(msg.header.stamp)  # [ns]
+        if not self._lockstep.accepts(computed):
             return  # it answers a state of the world before the last reset
         if self._stale(computed):
             return
@@ -186,13 +157,8 @@ class SimNode(Node):
             self.get_logger().warn(f'ignoring actuator_command: {error}',
                                    throttle_duration_sec=1.0)
             return
-        self._unanswered = False  # a controller answers: wait for it again
-        if (not self.config.lockstep
-                or (stamp.sec, stamp.nanosec) != sim_time(self.sim.steps, self._time_step_ns)):
-            return
-        self._command_ready = True
-        if not self._paused:
-            self._advance_when_due()
+        if self.config.lockstep and self._lockstep.heard(computed, time.monotonic_ns()):
+            self._advance()
 
     def _stale(self, computed: int) -> bool:
         """
@@ -215,11 +181,10 @@ class SimNode(Node):
         return True
 
     def _on_set_paused(self, request: SetBool.Request, response: SetBool.Response):
-        self._paused = request.data
-        self._period_start_wall = time.monotonic()  # the lockstep timeout restarts
+        advance = self._lockstep.set_paused(request.data, time.monotonic_ns())
         response.success = True
-        response.message = 'paused' if self._paused else 'running'
-        if not self._paused and self._command_ready:
+        response.message = 'paused' if request.data else 'running'
+        if advance:
             self._advance()
         return response
 
@@ -227,7 +192,7 @@ class SimNode(Node):
         if not 1 <= request.steps <= MAX_STEPS_PER_CALL:
             response.success = False
             response.message = f'steps must be in [1, {MAX_STEPS_PER_CALL}], got {request.steps}'
-        elif not (self._paused or self.config.lockstep):
+        elif not (self._lockstep.paused or self.config.lockstep):
             response.success = False
             response.message = 'the sim is free running: pause it (~/set_paused) or use lockstep'
         else:
@@ -240,7 +205,7 @@ class SimNode(Node):
                 if self.sim.steps % per_period == 0:
                     self._periods += 1
                     self._publish_state()
-            self._command_ready = False
+            self._lockstep.stepped(self.sim.steps * self._time_step_ns)
             response.success = True
             response.message = f'stepped {request.steps} steps'
         response.sim_time = self._stamp()
@@ -262,11 +227,8 @@ class SimNode(Node):
         self.sim.step(self.config.steps_per_period
                       - self.sim.steps % self.config.steps_per_period)
         self._periods += 1
-        self._command_ready = False
-        self._reset_ns = self.sim.steps * self._time_step_ns
         self._reset_pub.publish(Header(stamp=self._stamp(), frame_id=self.config.world_frame_id))
-        self._period_start_wall = time.monotonic()
-        self._publish_state()
+        self._lockstep.reset(self._publish_messages(), time.monotonic_ns())
         return response
 
     def _on_spawn(self, request: SpawnObstacle.Request, response: SpawnObstacle.Response):
