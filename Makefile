@@ -42,7 +42,7 @@ BUILD_INPUTS := $(shell find swivel_car_* -type f -not -path '*/__pycache__/*' \
 $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	@echo '== building ros2_ws'
 	@# A file removed from a package leaves a dangling symlink that fails the symlink install.
-	-find ros2_ws/build ros2_ws/install -xtype l -delete 2>/dev/null
+	find ros2_ws/build ros2_ws/install -xtype l -delete 2>/dev/null || true
 	rm -f ros2_ws/install/.swivel_car_built_*
 	cd ros2_ws && ../$(IN_WS) colcon build --symlink-install --event-handlers console_cohesion- summary+ \
 	    --cmake-args -DBUILD_TESTING=OFF -DSWIVEL_CAR_MSGS_CPP=$(MSGS_CPP)
