@@ -21,7 +21,7 @@ import os
 import sys
 import time
 
-from demo import NODE_PARAMETERS, NODES, stamp_seconds
+from demo import NODE_PARAMETERS, NODES
 from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -36,6 +36,7 @@ from swivel_car_msgs.action import ClimbStep
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ResetSimulation, SpawnObstacle
 from swivel_car_planner.core import capability
+from swivel_car_ros.ros_params import stamp_to_seconds
 from swivel_car_stack import spin_until, start_node
 
 STEP_DISTANCE = 1.2  # [m] ahead of the front axle after each reset
@@ -75,7 +76,7 @@ class SoakNode(Node):
     def _count(self, topic: str, msg) -> None:
         self.counts[topic] += 1
         if topic == 'joint_states':
-            self.sim_time = stamp_seconds(msg.header.stamp)
+            self.sim_time = stamp_to_seconds(msg.header.stamp)
 
     def drive(self, v: float, omega: float) -> None:
         msg = TwistStamped()
