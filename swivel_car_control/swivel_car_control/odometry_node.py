@@ -143,10 +143,8 @@ class OdometryNode(Node):
 
     def _apply_config(self, config: OdometryConfig) -> None:
         self._config = config
-        self._pose_covariance = _diagonal(config.pose_covariance_diagonal)
-        self._twist_covariance = _diagonal(config.twist_covariance_diagonal)
-        self._odom.pose.covariance = self._pose_covariance
-        self._odom.twist.covariance = self._twist_covariance
+        self._odom.pose.covariance = _diagonal(config.pose_covariance_diagonal)
+        self._odom.twist.covariance = _diagonal(config.twist_covariance_diagonal)
 
     def _make_tf_broadcaster(self):
         try:
