@@ -170,6 +170,11 @@ def ros_run():
     return result, first_tick, recorder, logs
 
 
+# Known flaky under load (2 of about 20 runs this session): the recorder, outside the chain,
+# missed 22 and 108 ground truths in a row (the sim's writer keeps 100), so the runs could not
+# be compared at all; cause not established. Only that failure is run again, at most twice; a
+# difference between the runs is not.
+@pytest.mark.flaky(reruns=2, only_rerun=['control periods not recorded'])
 def test_a_ros_lockstep_climb_is_the_in_process_climb(ros_run):
     ros, first_tick, recorder, logs = ros_run
     # The chain must have held: no node went on without the command it waits for.

@@ -647,7 +647,7 @@ def test_a_clock_far_ahead_stretches_no_deadman_and_every_node_survives_it(stack
 # whether it answers the next real state before this driver's next cmd_vel comes is a race, and
 # each drop costs a re-ramp of about 0.05 m. The fix belongs in the controller (a single stamp
 # going back is not a new world); until then a failure is run again, at most twice.
-@pytest.mark.flaky(reruns=2, only_rerun=['AssertionError'])
+@pytest.mark.flaky(reruns=2, only_rerun=['did not go on obeying cmd_vel'])
 def test_single_untrusted_joint_states_while_driving_move_neither_odom_nor_car(stack: Stack):
     """
     Check the issue 12 fault: one impossible joint_states corrupted the odometry for good.
