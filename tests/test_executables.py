@@ -7,12 +7,15 @@ That is install/<pkg>/lib/<pkg>/; each starts as a node and exits cleanly on SIG
 from __future__ import annotations
 
 import ast
+import itertools
+import os
 
 import pytest
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from swivel_car_testing import executable_path, NodeProcess, REPO_ROOT, spin_until
 
+_STARTS = itertools.count()
 PYTHON_PACKAGES = sorted(path.parent.name for path in REPO_ROOT.glob('swivel_car_*/setup.py'))
 
 
@@ -42,17 +45,21 @@ def test_executable_installed_and_starts(ros_domain, package, executable):
     domain_id, context = ros_domain
     path = executable_path(package, executable)
     assert path.stat().st_mode & 0o111, f'{path} is not executable'
-    process = NodeProcess(package, executable, domain_id)
+    # The node is named after its executable (sim_node: 'sim'), in a namespace of this test's
+    # own: the domain ids come round again, and a node of that name killed by an earlier test
+    # stays in the graph for seconds. Seen in it, it ended the wait while this one still
+    # imported, and SIGINT then ended the import with a traceback.
+    namespace = f'/executable_test_{os.getpid()}_{next(_STARTS)}'
+    process = NodeProcess(package, executable, domain_id,
+                          extra_args=('--ros-args', '-r', f'__ns:={namespace}'))
     probe = Node('executable_probe', context=context)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(probe)
     try:
-        # The node is named after its executable (sim_node: 'sim'). Waiting for that name,
-        # not any node, keeps a straggler of an earlier test from ending the wait while this
-        # one still imports (SIGINT then would not exit cleanly).
-        name = executable.removesuffix('_node')
-        spin_until(executor, lambda: not process.running() or name in probe.get_node_names(),
-                   30.0, f'{executable} to join the ROS graph as {name}')
+        node = (executable.removesuffix('_node'), namespace)
+        spin_until(executor, lambda: not process.running()
+                   or node in probe.get_node_names_and_namespaces(),
+                   30.0, f'{executable} to join the ROS graph as {namespace}/{node[0]}')
         assert process.running(), process.output()
         assert process.stop() == 0, process.output()
     finally:

@@ -642,12 +642,6 @@ def test_a_clock_far_ahead_stretches_no_deadman_and_every_node_survives_it(stack
     stack.wait_planner_ready()
 
 
-# Known flaky (about 1 run in 5 here, x 0.426 m against 0.45): the controller takes a
-# joint_states stamped before the last one for a restarted sim and drops the cmd_vel in force;
-# whether it answers the next real state before this driver's next cmd_vel comes is a race, and
-# each drop costs a re-ramp of about 0.05 m. The fix belongs in the controller (a single stamp
-# going back is not a new world); until then a failure is run again, at most twice.
-@pytest.mark.flaky(reruns=2, only_rerun=['did not go on obeying cmd_vel'])
 def test_single_untrusted_joint_states_while_driving_move_neither_odom_nor_car(stack: Stack):
     """
     Check the issue 12 fault: one impossible joint_states corrupted the odometry for good.
@@ -674,10 +668,14 @@ def test_single_untrusted_joint_states_while_driving_move_neither_odom_nor_car(s
     stack.wait_sim_time(0.1, 'the odometry of the stop')
 
     odom = stack.odom[odom_count:]
-    steps = [math.hypot(b.pose.pose.position.x - a.pose.pose.position.x,
-                        b.pose.pose.position.y - a.pose.pose.position.y)
-             for a, b in zip(odom, odom[1:])]
-    assert max(steps) < 0.02, f'the odom jumped {max(steps):.3g} m'
-    assert stack.x() > 0.45, 'the car did not go on obeying cmd_vel'  # 0.55 m undisturbed
+    # As speeds: the odometry, outside the chain, may skip states of the unpaced sim under
+    # load and publish one longer step (0.042 m over 12 periods, seen once).
+    speeds = [math.hypot(b.pose.pose.position.x - a.pose.pose.position.x,
+                         b.pose.pose.position.y - a.pose.pose.position.y)
+              / max(stamp_to_seconds(b.header.stamp) - stamp_to_seconds(a.header.stamp), 1e-9)
+              for a, b in zip(odom, odom[1:])]
+    assert max(speeds) < 1.0, f'the odom jumped at {max(speeds):.3g} m/s (drive: 0.3 m/s)'
+    # 0.55 m undisturbed
+    assert stack.x() > 0.45, f'the car did not go on obeying cmd_vel: x {stack.x():.3f} m'
     assert odom[-1].pose.pose.position.x == pytest.approx(stack.x(), rel=0.05)
     stack.wait_planner_ready()

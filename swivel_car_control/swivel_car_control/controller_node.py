@@ -186,8 +186,12 @@ class ControllerNode(Node):
         try:
             # The deadman counts from receipt: a planner that lags behind a lockstep sim
             # running ahead of it (before its first command held the sim back) is not dead.
+            # Receipt is after the last state answered: its stamp, exact where the node clock
+            # moves in steps of a thinned /clock (the in-process stack takes the same).
+            received = self._joint_states.last_time
             self._core.set_swivel_command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold,
-                                          self._now(), msg.free)
+                                          self._now() if received is None else received,
+                                          msg.free)
         except ValueError as error:
             self.get_logger().error(str(error), throttle_duration_sec=1.0)
         else:

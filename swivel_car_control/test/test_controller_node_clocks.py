@@ -114,3 +114,13 @@ def test_a_clock_far_ahead_does_not_stretch_the_swivel_command_deadman(rig):
     assert rig.step(0.1, clock=False).drive_speed > 0.0
     assert rig.step(TIMEOUT + 0.3).drive_speed == 0.0
     assert rig.step(1.0).drive_speed == 0.0
+
+
+def test_a_clock_in_steps_does_not_shorten_the_swivel_command_deadman(rig):
+    rig.step(0.1)
+    rig.step(0.09, clock=False)  # /clock thinned to 10 Hz: the node clock 0.09 s behind
+    rig.publish(rig.swivel, SwivelCommand(angle=0.0, drive_speed=3.0, hold=True))
+    speeds = [rig.step(clock=False).drive_speed for _ in range(round((TIMEOUT - 0.02) / PERIOD))]
+    # Held throughout, the drive only ramps up; timed out early, it would ramp down.
+    assert speeds == sorted(speeds) and speeds[-1] > 0.0
+    assert rig.step(0.3, clock=False).drive_speed < speeds[-1]  # then it does time out

@@ -30,7 +30,7 @@ from swivel_car_control.test.test_system import _seconds, _yaw
 from swivel_car_model.description import CarDescription
 from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ResetSimulation
-from swivel_car_ros.ros_params import moment_seconds
+from swivel_car_ros.lockstep import ChainEntry, Entry, stamp_ns
 from swivel_car_testing import (
     lockstep_parameters, next_domain_id, spin_until, start_node)
 
@@ -56,8 +56,8 @@ class RouteDriver:
         self.time = -1.0  # [s] stamp of the last controller state
         self.odom_time = -1.0  # [s] stamp of the last odom
         self.unanswered: SwivelControllerState | None = None  # waiting for its odom
-        # A route to start: its segments, and the stamp of its first command once sent [s].
-        self.start: tuple[list[Segment], float | None] | None = None
+        # A route to start: its segments, and its way into the lockstep chain.
+        self.start: tuple[list[Segment], ChainEntry] | None = None
         self.plan: list[tuple[float, Segment]] = []  # (end time [s], segment)
         self.end = 0.0  # [s] of the route started last
         self.cmd_vel = self.node.create_publisher(TwistStamped, 'cmd_vel', 10)
@@ -88,12 +88,11 @@ class RouteDriver:
         self.unanswered = None
         t = _seconds(msg)
         if self.start is not None:
-            segments, first = self.start
-            if first is None or moment_seconds(msg.cmd_vel_stamp) < first:
-                # Until the controller has heard the route's first command it does not wait
-                # for this driver, and the sim may run ahead: that command stands for each
-                # such moment, and the route starts from the first state that applies it.
-                self.start = (segments, t if first is None else first)
+            segments, entry = self.start
+            # The first command stands for each state until the controller reports it; the
+            # route starts from the first state that applies it.
+            heard = stamp_ns(msg.cmd_vel_stamp) or -1  # [ns] -1: none, below a state at 0
+            if entry.state(stamp_ns(msg.header.stamp), heard) in (Entry.FIRST, Entry.REPEAT):
                 self._command(segments[0], msg.header)
                 return
             self.start = None
@@ -133,7 +132,7 @@ class RouteDriver:
 
     def run(self, segments: list[Segment]) -> float:
         """Drive ``segments`` from the next controller state on; returns their end time [s]."""
-        self.start = (segments, None)
+        self.start = (segments, ChainEntry())
         spin_until(self.executor, lambda: self.start is None and not self.plan, 600.0,
                    'the segments')
         return self.end

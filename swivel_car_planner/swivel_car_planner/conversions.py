@@ -49,7 +49,7 @@ def _aligned(offset: int, size: int) -> int:
     return offset + (-offset) % size
 
 
-def _read_header(data: bytes) -> tuple[Time, int]:
+def read_header(data: bytes) -> tuple[Time, int]:
     """
     Read the std_msgs/Header a serialized message starts with.
 
@@ -76,7 +76,7 @@ def odom_fields(data: bytes) -> tuple[Time, float, float, tuple[float, float, fl
     Returns stamp, position x, y [m], orientation quaternion (x, y, z, w) and forward speed
     (twist.linear.x) [m/s].
     """
-    stamp, offset = _read_header(data)
+    stamp, offset = read_header(data)
     offset = _aligned(offset, 4)  # child_frame_id
     (length,) = struct.unpack_from('<I', data, _CDR_START + offset)
     offset = _aligned(offset + 4 + length, 8)  # pose.pose.position
@@ -88,6 +88,6 @@ def odom_fields(data: bytes) -> tuple[Time, float, float, tuple[float, float, fl
 
 def imu_fields(data: bytes) -> tuple[Time, tuple[float, float, float, float]]:
     """Read a serialized sensor_msgs/Imu: its stamp and orientation quaternion (x, y, z, w)."""
-    stamp, offset = _read_header(data)
+    stamp, offset = read_header(data)
     orientation = struct.unpack_from('<4d', data, _CDR_START + _aligned(offset, 8))
     return stamp, orientation

@@ -48,6 +48,7 @@ from swivel_car_planner.core import (
     capability, ClimbPlan as Plan, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs,
     make_plan, PlanError, PlannerConfig, validate_request)
 from swivel_car_planner.core.sync import InputSync, Tick
+from swivel_car_ros.lockstep import ChainEntry, Entry
 from swivel_car_ros.ros_params import (
     declare_description, moment_seconds, run_node, stamp_to_seconds)
 
@@ -60,7 +61,7 @@ class _ActiveClimb:
     """
     The one running climb, and who waits for it.
 
-    It is engaged once the controller has heard its first command: from then on the
+    Its ``entry`` engages once the controller has heard its first command: from then on the
     controller (in the lockstep chain) waits for each of its commands, so its ticks come one
     control period apart.
     """
@@ -70,9 +71,8 @@ class _ActiveClimb:
     answer: Callable[[_Result], None]  # takes the result once the climb has ended
     goal_handle: ServerGoalHandle | None = None
     machine: ClimbStateMachine = field(init=False)
-    first_command: tuple[Command, float] | None = None  # (command, stamp [s])
-    engaged: bool = False
-    waited: bool = False  # ticks passed between the first command and the engagement
+    entry: ChainEntry = field(default_factory=ChainEntry)  # its way into the chain
+    first_command: Command | None = None  # stands for each tick until the entry engages
 
     def __post_init__(self) -> None:
         self.machine = self.new_machine()
@@ -417,29 +417,24 @@ class PlannerNode(Node):
         self._last_tick = self._now()
         self._last_tick_wall = time.monotonic()
         self._quiet_checks = self._quiet_wall_checks = 0
-        if climb.first_command is not None and not climb.engaged:
-            command, first_stamp = climb.first_command
-            if inputs.command_heard(tick) < first_stamp:
-                # Until the controller waits for the planner, the sim may run ahead of it by
-                # any time: the first command stands for each such moment.
-                climb.waited = True
-                self._publish_command(command, tick.time)
-                return
-            climb.engaged = True
-            if climb.waited:
-                # The moment the first command answered is gone: the climb starts afresh
-                # from this one, which the controller holds.
-                climb.machine = climb.new_machine()
-                self.get_logger().info(
-                    f'the controller heard the first command of {first_stamp:.2f} s only at '
-                    f'{tick.time:.2f} s: the climb starts from there')
-        if climb.engaged:
+        entry = climb.entry.state(tick.time, inputs.command_heard(tick))
+        if entry is Entry.REPEAT:
+            self._publish_command(climb.first_command, tick.time)
+            return
+        if entry is Entry.ENGAGED_LATE:
+            # The moment the first command answered is gone: the climb starts afresh from
+            # this one, which the controller holds.
+            climb.machine = climb.new_machine()
+            self.get_logger().info(
+                f'the controller heard the first command of {climb.entry.first:.2f} s only at '
+                f'{tick.time:.2f} s: the climb starts from there')
+        if climb.entry.engaged:
             self._last_tick_stamp = tick.time
         if climb.goal_handle is not None and climb.goal_handle.is_cancel_requested:
             climb.machine.cancel()
         command = climb.machine.update(inputs.observation(tick))
-        if climb.first_command is None:
-            climb.first_command = (command, tick.time)
+        if entry is Entry.FIRST:
+            climb.first_command = command
         self._publish_command(command, tick.time)
         if climb.goal_handle is not None:
             climb.goal_handle.publish_feedback(self._feedback_msg(climb.machine.feedback))
@@ -455,7 +450,7 @@ class PlannerNode(Node):
         loaded machine), this timer runs before the queued inputs and would see a stale tick.
         """
         climb = self._climb
-        if climb is None or not climb.engaged:
+        if climb is None or not climb.entry.engaged:
             return  # the sim is not held back for the planner yet: sim time may race
         self._quiet_checks += 1
         now = self._now()

@@ -2,14 +2,16 @@
 The lockstep protocol (docs/architecture.md, "Timing: sim time and lockstep"), ROS-free.
 
 One owner for the chain's timing: ``SimLockstep`` decides when the sim advances,
-``ChainedAnswers`` when the controller answers a state. Stamps are integer nanoseconds of sim
-time (0: none); the wall clock is the caller's (``now_ns``, a steady clock in ns, passed to
-every call), so the protocol runs the same under a fake clock in tests.
+``ChainedAnswers`` when the controller answers a state, ``ChainEntry`` when a source that
+joins the chain (the planner, a driver) may act on the states it hears. Stamps are integer
+nanoseconds of sim time (0: none); the wall clock is the caller's (``now_ns``, a steady clock
+in ns, passed to every call), so the protocol runs the same under a fake clock in tests.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+import enum
 from typing import Any, Generic, NamedTuple, TypeVar
 
 T = TypeVar('T')
@@ -293,3 +295,48 @@ class ChainedAnswers(Generic[T]):
     def _take(self) -> T | None:
         item, self._pending = self._pending, None
         return item
+
+
+class Entry(enum.Enum):
+    """What a source joining the chain does with a state (``ChainEntry.state``)."""
+
+    FIRST = 'first'  # send its first command, answering this state
+    REPEAT = 'repeat'  # send its first command again, answering this state
+    ENGAGED = 'engaged'  # the controller holds the first command: go on from it
+    ENGAGED_LATE = 'engaged late'  # as ENGAGED, but states passed meanwhile: start afresh here
+    ON = 'on'  # engaged before: act on this state
+
+
+class ChainEntry:
+    """
+    A source's way into the lockstep chain (docs/architecture.md).
+
+    The controller waits for a source only from its first stamped command on, so until the
+    controller reports hearing that command the sim may run ahead of the source by any time.
+    The first command then stands for each state the source hears; once the controller
+    reports it, the source goes on, from the state it answers then if states passed
+    meanwhile. Stamps of one clock in one unit (the chain's ns, or seconds), compared only
+    with each other; a controller that heard none reports one below any state's.
+    """
+
+    def __init__(self) -> None:
+        self.first: float | None = None  # stamp of the state the first command answered
+        self.engaged = False
+        self._waited = False  # a state passed between the first command and the engagement
+
+    def state(self, stamp: float, heard: float) -> Entry:
+        """
+        Take a state of ``stamp`` whose controller reports ``heard``: its last command heard.
+
+        Returns what the source does with that state.
+        """
+        if self.engaged:
+            return Entry.ON
+        if self.first is None:
+            self.first = stamp
+            return Entry.FIRST
+        if heard < self.first:
+            self._waited = True
+            return Entry.REPEAT
+        self.engaged = True
+        return Entry.ENGAGED_LATE if self._waited else Entry.ENGAGED

@@ -1,8 +1,10 @@
 """The lockstep protocol under a fake wall clock: each call is given its time in ns."""
 
+import math
+
 from builtin_interfaces.msg import Time
 from swivel_car_ros.lockstep import (
-    ChainedAnswers, REPUBLISH_PERIOD_NS, SimLockstep, SimTick, stamp_ns)
+    ChainedAnswers, ChainEntry, Entry, REPUBLISH_PERIOD_NS, SimLockstep, SimTick, stamp_ns)
 
 MS = 1_000_000  # [ns]
 PERIOD = 10 * MS  # [ns] sim time of a control period
@@ -267,3 +269,26 @@ def test_the_last_stamped_command_is_kept_in_the_callers_form_until_a_reset():
     assert chain.planner.heard_stamp is stamp and chain.planner.heard_ns == 1_000_000_010
     chain.forget(2 * PERIOD)
     assert chain.planner.heard_stamp is None and chain.planner.heard_ns == 0
+
+
+def test_a_source_acts_on_the_state_after_its_first_command_when_heard_at_once():
+    entry = ChainEntry()
+    assert entry.state(1 * PERIOD, 0) is Entry.FIRST
+    assert entry.state(2 * PERIOD, 1 * PERIOD) is Entry.ENGAGED and entry.engaged
+    assert entry.state(3 * PERIOD, 2 * PERIOD) is Entry.ON
+
+
+def test_a_source_repeats_its_first_command_until_the_controller_reports_it():
+    entry = ChainEntry()
+    assert entry.state(1 * PERIOD, 0) is Entry.FIRST
+    assert entry.state(2 * PERIOD, 0) is Entry.REPEAT  # the sim ran ahead: not yet heard
+    assert entry.state(5 * PERIOD, 0) is Entry.REPEAT and not entry.engaged
+    assert entry.state(6 * PERIOD, 5 * PERIOD) is Entry.ENGAGED_LATE
+    assert entry.state(7 * PERIOD, 0) is Entry.ON  # engaged: what it reports no longer matters
+
+
+def test_an_entry_works_in_seconds_with_minus_infinity_for_none_heard():
+    entry = ChainEntry()
+    assert entry.state(0.01, -math.inf) is Entry.FIRST
+    assert entry.state(0.02, -math.inf) is Entry.REPEAT
+    assert entry.state(0.03, 0.02) is Entry.ENGAGED_LATE

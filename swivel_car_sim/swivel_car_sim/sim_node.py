@@ -131,7 +131,8 @@ class SimNode(Node):
         messages = self._messages
         state = self.sim.state()
         sec, nanosec = sim_time(self.sim.steps, self._time_step_ns)
-        self._clock_pub.publish(messages.clock(sec, nanosec))
+        if self._periods % self.config.clock_every == 0:
+            self._clock_pub.publish(messages.clock(sec, nanosec))
         self._joint_pub.publish(messages.joint_state(state, sec, nanosec))
         # imu and ground truth are built only when heard (asking: 1.5 us; building and
         # publishing to nobody: 10 us); a subscriber that appears gets the next one anyway.

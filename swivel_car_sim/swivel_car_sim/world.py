@@ -13,6 +13,7 @@ from types import MappingProxyType
 
 import numpy as np
 import pybullet
+from swivel_car_model.checks import check_finite_number
 
 
 @dataclass(frozen=True)
@@ -34,9 +35,7 @@ class StepSpec:
     def validate(self) -> None:
         """Raise ValueError naming the first bad field."""
         for name in ('height', 'depth', 'width', 'distance', 'yaw', 'friction'):
-            value = getattr(self, name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise ValueError(f'{name} must be finite, got {value!r}')
+            check_finite_number(name, getattr(self, name))  # a bool too: True, a 1 m step
         if not 0.0 < self.height <= 1.0:
             raise ValueError(f'height must be in (0, 1] m, got {self.height!r}')
         for name in ('depth', 'width'):

@@ -18,16 +18,17 @@ def test_defaults_give_the_architecture_timing():
     assert cfg.physics.time_step == 0.002
     assert cfg.control_period == 0.01
     assert cfg.steps_per_period == 5
-    assert cfg.imu_every == cfg.ground_truth_every == 1
+    assert cfg.clock_every == cfg.imu_every == cfg.ground_truth_every == 1
     assert not cfg.lockstep
     assert cfg.physics.description == CarDescription()
 
 
 def test_rates_and_geometry_overrides():
     cfg = SimNodeConfig.from_values({'ground_truth_rate': 20.0, 'imu_rate': 50.0,
+                                     'clock_rate': 10.0,
                                      'phi': -0.5, 'body_mass': 10, 'time_step': 0.001,
                                      'rear_differential': 'locked'})
-    assert cfg.ground_truth_every == 5 and cfg.imu_every == 2
+    assert cfg.ground_truth_every == 5 and cfg.imu_every == 2 and cfg.clock_every == 10
     assert cfg.steps_per_period == 10
     assert cfg.physics.description.phi == -0.5
     assert cfg.physics.description.body_mass == 10.0
@@ -42,6 +43,8 @@ def test_rates_and_geometry_overrides():
     ({'world_frame_id': ''}, 'world_frame_id'),
     ({'base_frame_id': 3}, 'base_frame_id'),
     ({'imu_rate': 0.0}, 'imu_rate'),
+    ({'clock_rate': 30.0}, 'clock_rate'),
+    ({'clock_rate': 'fast'}, 'clock_rate'),
     ({'ground_truth_rate': 70.0}, 'ground_truth_rate'),
     ({'lockstep_timeout': -1.0}, 'lockstep_timeout'),
     ({'lockstep_real_time_factor': -0.5}, 'lockstep_real_time_factor'),
@@ -120,8 +123,9 @@ def test_property_good_values_are_taken(steps, every, x, factor, lockstep):
     rate = 1.0 / (0.002 * steps * every)  # [Hz]
     config = SimNodeConfig.from_values({
         'control_period': 0.002 * steps, 'imu_rate': rate, 'ground_truth_rate': rate,
-        'initial_x': x, 'real_time_factor': factor, 'lockstep': lockstep})
+        'clock_rate': rate, 'initial_x': x, 'real_time_factor': factor, 'lockstep': lockstep})
     assert config.steps_per_period == steps and config.imu_every == every
+    assert config.clock_every == every
     assert config.initial_pose[0] == x and config.real_time_factor == factor
     assert config.lockstep is lockstep
 

@@ -263,11 +263,12 @@ def test_commands_are_clamped_to_the_limits(sim):
 STEP = {'name': '', 'height': 0.1, 'depth': 0.5, 'width': 1.0, 'distance': 0.2, 'yaw': 0.0,
         'friction': 0.1}
 BAD_STEPS = [
-    ({'height': math.nan}, 'height must be finite'),
+    ({'height': math.nan}, 'height must be a finite number'),
     ({'height': -0.05}, 'height must be in'),
     ({'height': 1.5}, 'height must be in'),
     ({'depth': 0.0}, 'depth must be in'),
-    ({'width': math.inf}, 'width must be finite'),
+    ({'width': math.inf}, 'width must be a finite number'),
+    ({'height': True}, 'height must be a finite number'),
     ({'distance': -0.1}, 'distance must be >= 0'),
     ({'yaw': math.pi / 2}, 'yaw must be in'),
     ({'friction': 0.0}, 'friction must be in'),

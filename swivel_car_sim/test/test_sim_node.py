@@ -116,6 +116,20 @@ def test_lockstep_advances_one_period_per_matching_command(harness_factory):
     assert h.imu[-1].orientation.w == pytest.approx(1.0, abs=1e-3)
 
 
+def test_clock_rate_publishes_every_nth_state_time_on_clock(harness_factory):
+    h = harness_factory(lockstep=True, lockstep_timeout=0.0, clock_rate=10.0)
+    spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
+    while _ns(h.joint_states[-1].header.stamp) < 250_000_000:
+        count = len(h.joint_states)
+        h.command(h.joint_states[-1].header.stamp)
+        spin_until(h.executor, lambda: len(h.joint_states) > count, TIMEOUT, 'next state')
+    spin_until(h.executor, lambda: h.clock and _ns(h.clock[-1].clock) == 200_000_000, TIMEOUT,
+               '/clock of 0.2 s')
+    states = {_ns(m.header.stamp) for m in h.joint_states}
+    assert states >= set(range(0, 250_000_001, 10_000_000))
+    assert {_ns(m.clock) for m in h.clock} & states == {0, 100_000_000, 200_000_000}
+
+
 def test_lockstep_ignores_stale_stamps_and_non_finite_commands(harness_factory):
     h = harness_factory(lockstep=True, lockstep_timeout=0.0)
     spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
@@ -220,7 +234,7 @@ def test_pause_stops_free_running_and_step_moves_it(harness_factory):
 
 
 @pytest.mark.parametrize('change, message', [
-    ({'height': math.nan}, 'height must be finite'), ({'height': -0.1}, 'height'),
+    ({'height': math.nan}, 'height must be a finite number'), ({'height': -0.1}, 'height'),
     ({'distance': 0.0, 'height': 0.05}, 'overlap'), ({'yaw': 2.0}, 'yaw')])
 def test_bad_spawn_is_refused_with_a_message_and_changes_nothing(harness_factory, change,
                                                                  message):

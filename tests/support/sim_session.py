@@ -9,6 +9,7 @@ ground truth. Processes come from the repository's scripts/swivel_car_stack.py.
 
 from __future__ import annotations
 
+import itertools
 import os
 from pathlib import Path
 import sys
@@ -38,6 +39,8 @@ CLIMB_WALL_LIMIT = 600.0  # [s] guard against a hung stack, not a measurement
 # [s] wall; half of it the controller waits for the planner. A loaded CI machine held a
 # node up for seconds: within it, the climb stays deterministic.
 LOCKSTEP_TIMEOUT = 6.0
+RESEND_AFTER = 5.0  # [s] wall
+REPORT_CHARS = 1500  # [1] of each process' output in a timeout's report
 
 
 class SimSession:
@@ -119,6 +122,7 @@ class SimSession:
         self.climb_action = ActionClient(self.node, ClimbStepAction, 'climb_step')
         self.swivel_command = self.node.create_publisher(SwivelCommand, 'swivel_command', 10)
         self._planner = planner
+        self._step_names = itertools.count()  # numbers the steps asked for
 
     def _on_truth(self, msg: Odometry) -> None:
         self.truth = GroundTruth.from_msg(msg)
@@ -131,7 +135,17 @@ class SimSession:
         self.controller_state = msg
 
     def spin_until(self, condition: Callable[[], bool], timeout: float, what: str) -> None:
-        spin_until(self.executor, condition, timeout, what)
+        try:
+            spin_until(self.executor, condition, timeout, what)
+        except TimeoutError as error:
+            # What each node said is the only trace of why a load-dependent wait ran out.
+            raise TimeoutError(f'{error}\n{self.report()}') from None
+
+    def report(self) -> str:
+        """Each process: running or its exit code, and the end of what it printed."""
+        return '\n'.join(
+            f'--- {p.name}: {"running" if p.running() else f"exited {p.process.returncode}"}'
+            f'\n{p.output()[-REPORT_CHARS:]}' for p in self.processes)
 
     def wait_ready(self, timeout: float = 60.0) -> None:
         """Until the sim, the controller and the odometry publish and the services are up."""
@@ -153,10 +167,27 @@ class SimSession:
                     raise AssertionError('the planner never got ready')
                 self.settle(0.2)
 
-    def call(self, client, request, timeout: float = 30.0):
-        future = client.call_async(request)
-        self.spin_until(future.done, timeout, f'{client.srv_name}')
-        return future.result()
+    def call(self, client, request, timeout: float = 30.0, resend: bool = False):
+        """
+        Return the service's response.
+
+        ``resend``: for a request that may come twice, sent again every ``RESEND_AFTER`` wall
+        seconds until one is answered. A server that has not yet discovered this client's
+        response reader drops the response (rclpy logs "failed to send response ...
+        (timeout)"); under load that window outlasted the discovery waits.
+        """
+        start = time.monotonic()
+        futures = [client.call_async(request)]
+
+        def answered() -> bool:
+            if any(f.done() for f in futures):
+                return True
+            if resend and time.monotonic() > start + RESEND_AFTER * len(futures):
+                futures.append(client.call_async(request))
+            return False
+
+        self.spin_until(answered, timeout, f'{client.srv_name}')
+        return next(f for f in futures if f.done()).result()
 
     def reset(self, x: float = 0.0, y: float = 0.0, yaw: float = 0.0) -> None:
         """
@@ -165,15 +196,15 @@ class SimSession:
         The controller starts afresh from the reset state (sim/reset_event).
         """
         response = self.call(self.reset_client, ResetSimulation.Request(
-            x=x, y=y, yaw=yaw, remove_obstacles=True))
+            x=x, y=y, yaw=yaw, remove_obstacles=True), resend=True)
         if not response.success:
             raise RuntimeError(f'sim reset failed: {response.message}')
         self.settle(0.3)
-        self.call(self.odometry_reset, Empty.Request())
+        self.call(self.odometry_reset, Empty.Request(), resend=True)
         self.settle(0.2)
 
     def set_paused(self, paused: bool) -> None:
-        response = self.call(self.pause_client, SetBool.Request(data=paused))
+        response = self.call(self.pause_client, SetBool.Request(data=paused), resend=True)
         if not response.success:
             raise RuntimeError(f'sim set_paused failed: {response.message}')
 
@@ -184,9 +215,14 @@ class SimSession:
 
     def spawn_step(self, height: float, distance: float, yaw: float = 0.0,
                    depth: float = 2.0, width: float = 3.0, friction: float = 1.0) -> str:
+        # Named, so that a resent request whose first was spawned is told so.
+        name = f'session_step_{next(self._step_names)}'
         response = self.call(self.spawn_client, SpawnObstacle.Request(obstacle=StepObstacle(
-            name='', height=height, depth=depth, width=width, distance=distance, yaw=yaw,
-            friction=friction)))
+            name=name, height=height, depth=depth, width=width, distance=distance, yaw=yaw,
+            friction=friction)), resend=True)
+        if not response.success and response.message.endswith(
+                f'an obstacle named {name!r} exists already'):
+            return name
         if not response.success:
             raise RuntimeError(f'spawn failed: {response.message}')
         return response.name

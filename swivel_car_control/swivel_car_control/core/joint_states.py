@@ -12,7 +12,7 @@ import math
 from typing import Sequence
 
 from swivel_car_control.core.controller import ControlOutput, SwivelController
-from swivel_car_control.joints import JointReader, JointSample
+from swivel_car_control.joints import JointReader, JointSample, MissingJointError
 from swivel_car_model.checks import check_number
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_model.planar import OffsetTricycleOdometry
@@ -22,6 +22,13 @@ from swivel_car_model.planar import OffsetTricycleOdometry
 YAW_RATE_SOURCES = ('swivel', 'rear_wheels')
 # A swivel reading this far past the joint limit (compliance, sensor noise) is clamped to it.
 LIMIT_SLACK = 0.05  # [rad]
+# Longest gap between two joint_states taken as the same run; a sim at 10 Hz or more never
+# leaves one this long, a fake stamp does.
+MAX_GAP = 1.0  # [s]
+
+
+class UnconfirmedStamp(MissingJointError):
+    """The message's stamp jumped back, or ahead by more than ``MAX_GAP``: not yet trusted."""
 
 
 def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
@@ -34,7 +41,10 @@ class JointStateController:
     The controller's answer to one ``joint_states``.
 
     The swivel joint read by name (its rate differenced from positions when not reported),
-    then one ``SwivelController.step``.
+    then one ``SwivelController.step``. A stamp that jumps back or more than ``MAX_GAP``
+    ahead is trusted once the next message follows it (a restarted sim starts again at 0);
+    until then nothing is stepped, so one faulty message drops no command and moves no
+    limiter (issue 12: a single stamp of 0 s while driving dropped the cmd_vel in force).
 
     Parameters
     ----------
@@ -50,6 +60,7 @@ class JointStateController:
         self._joints = JointReader([swivel_joint])
         self.last_time: float | None = None  # [s] stamp of the last message answered
         self._reset_at: float | None = None  # [s] time of a world reset not yet answered
+        self._jumped_to: float | None = None  # [s] stamp of an unconfirmed jump
 
     def reset(self, t: float) -> None:
         """
@@ -78,9 +89,19 @@ class JointStateController:
         Raises
         ------
         swivel_car_control.joints.MissingJointError
-            No usable swivel reading; nothing was stepped (answer with zero torque and drive).
+            No usable swivel reading, or an ``UnconfirmedStamp``; nothing was stepped (answer
+            with zero torque and drive).
 
         """
+        last = self.last_time
+        jumped_to, self._jumped_to = self._jumped_to, None  # only the next message confirms
+        if last is not None and not last <= t <= last + MAX_GAP and not (
+                jumped_to is not None and jumped_to < t <= jumped_to + MAX_GAP):
+            self._jumped_to = t
+            direction = 'before' if t < last else 'after'
+            raise UnconfirmedStamp(
+                f'joint_states stamp {t:.3f} s is {abs(t - last):.3f} s {direction} the last one '
+                f'({last:.3f} s): not acted on until the next message confirms the jump')
         if (self.last_time is not None and t < self.last_time) or (
                 self._reset_at is not None and t >= self._reset_at):
             self._joints.reset()

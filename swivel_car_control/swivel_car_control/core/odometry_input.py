@@ -21,12 +21,9 @@ import enum
 import math
 from typing import Mapping, Sequence
 
-from swivel_car_control.core.joint_states import JointStateOdometry
+from swivel_car_control.core.joint_states import JointStateOdometry, MAX_GAP
 from swivel_car_model.checks import check_number
 
-# Longest gap between two joint_states that is integrated across; a driver at 10 Hz or more
-# never leaves one this long, a fake stamp does.
-MAX_GAP = 1.0  # [s]
 # A wheel joint faster than this many times the drive's speed limit is a bad reading: an
 # open differential spins one wheel at up to twice the drive speed, skid adds a little.
 WHEEL_RATE_FACTOR = 3.0  # [1]
