@@ -358,7 +358,12 @@ class Stack:
         self.wait_planner_ready()
         climb = self.start_climb(ClimbStep.Request(
             step_height=0.04, step_distance=1.0, step_yaw=0.0, plan_only=False))
-        self.spin_until(lambda: self.speed() > 0.1 or climb.done(), 60.0, 'the climb to drive')
+        # Forward, on the planner's drive: turning the swivel alone moves base_link a little,
+        # backwards too.
+        self.spin_until(lambda: climb.done() or (
+            self.truth[-1].twist.twist.linear.x > 0.1
+            and self.controller_states[-1].source == 'swivel_command'
+            and self.controller_states[-1].drive_speed > 0.0), 60.0, 'the climb to drive')
         assert not climb.done(), climb.result().message
         self.kill(name)
         return climb
@@ -544,8 +549,16 @@ def test_killed_planner_mid_climb_stops_the_car_and_a_restart_recovers(stack: St
     stack.wait_stopped(1.2, 'the car to stop without a planner',
                        since=stack.last_swivel_command_heard)
     assert not climb.done()  # its server is gone; the client gives up on its own
+    # The controller's states and the ground truth come on separate topics, in either order.
     states = stack.controller_states
-    assert states[-1].source != 'swivel_command' and states[-1].drive_speed == 0.0
+    stack.spin_until(lambda: states[-1].source != 'swivel_command', 30.0,
+                     "the controller's states to show the released command")
+    last = max(i for i, state in enumerate(states) if state.source == 'swivel_command')
+    age = stamp_to_seconds(states[last + 1].header.stamp) - stamp_to_seconds(
+        states[last].swivel_command_stamp)
+    assert age <= 0.5 + 0.05, f'the swivel_command deadman took {age:.2f} s'
+    stack.spin_until(lambda: states[-1].drive_speed == 0.0, 30.0, 'a zero drive')
+    assert states[-1].source != 'swivel_command'
     stack.climbs.remove(climb)
 
     stack.restart('planner')
