@@ -50,7 +50,10 @@ def _parameter_argument(name: str, value: Any) -> str:
 
 class NodeProcess:
     """
-    A node executable running in its own process, its output kept in a log file.
+    A node executable running in its own process.
+
+    Its output goes to a log file in the temporary directory while it runs; once the process
+    is stopped or killed, the output is kept in memory and the file deleted.
 
     Parameters
     ----------
@@ -76,13 +79,22 @@ class NodeProcess:
             command += ['-p', _parameter_argument(name, value)]
         self.log = tempfile.NamedTemporaryFile(
             prefix=f'{executable}-', suffix='.log', delete=False)
+        self._final_output: str | None = None
         self.process = subprocess.Popen(
             command, env=ros_environment(domain_id), stdout=self.log,
             stderr=subprocess.STDOUT, start_new_session=True)
 
     def output(self) -> str:
-        """Everything the process printed so far."""
+        """Everything the process printed so far (kept once it is stopped or killed)."""
+        if self._final_output is not None:
+            return self._final_output
         return Path(self.log.name).read_text(errors='replace')
+
+    def _forget_log(self) -> None:
+        """Keep the output of the ended process in memory and delete its log file."""
+        self._final_output = self.output()
+        self.log.close()
+        Path(self.log.name).unlink(missing_ok=True)
 
     def running(self) -> bool:
         return self.process.poll() is None
@@ -96,13 +108,16 @@ class NodeProcess:
             except subprocess.TimeoutExpired:
                 os.killpg(self.process.pid, signal.SIGKILL)
                 self.process.wait()
-        self.log.close()
+        if self._final_output is None:
+            self._forget_log()
         return self.process.returncode
 
     def kill(self) -> None:
         """SIGKILL, as a crash would end it."""
         os.killpg(self.process.pid, signal.SIGKILL)
         self.process.wait()
+        if self._final_output is None:
+            self._forget_log()
 
 
 def config_path(package: str, file_name: str) -> Path:

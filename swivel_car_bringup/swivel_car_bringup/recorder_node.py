@@ -14,7 +14,6 @@ recorder may lag the publishers by many) are written before the bag is closed.
 from __future__ import annotations
 
 from pathlib import Path
-import signal
 import sys
 import time
 
@@ -139,23 +138,9 @@ class RecorderNode(Node):
         super().destroy_node()
 
 
-def _stop_quietly(signum, frame) -> None:
-    """
-    Do Python's part of a SIGINT/SIGTERM: nothing.
-
-    So that no KeyboardInterrupt lands inside a write. rclpy's handler, which calls this one, shuts
-    the context down and wakes the executor: the spin ends after the callback under way, and
-    destroy_node drains the queues and closes the bag. A second signal interrupts as usual (a stuck
-    close).
-    """
-    signal.signal(signal.SIGINT, signal.default_int_handler)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-
 def main(args=None) -> None:
-    # Before rclpy.init (in run_node): rclpy's handlers chain to these.
-    signal.signal(signal.SIGINT, _stop_quietly)
-    signal.signal(signal.SIGTERM, _stop_quietly)
+    # run_node ends the spin after the callback under way on a signal, so that no
+    # KeyboardInterrupt lands inside a write; destroy_node drains the queues and closes the bag.
     sys.exit(run_node(RecorderNode, 'recorder', args))
 
 

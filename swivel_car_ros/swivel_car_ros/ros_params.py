@@ -19,8 +19,8 @@ import rclpy
 from rclpy.exceptions import ParameterException
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.experimental import EventsExecutor
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
 from swivel_car_model import description
 from swivel_car_model.description import CarDescription
 
@@ -152,44 +152,40 @@ def run_node(node_class: type[Node], name: str, args: list[str] | None = None,
     """
     Run the Jazzy main loop for one node.
 
-    A refused parameter ends it with a clear error, a signal (Ctrl-C, SIGTERM) quietly, also
-    when it lands inside a callback.
+    A refused parameter ends it with a clear error, a signal (Ctrl-C, SIGTERM) quietly once
+    the callback in progress, if any, has returned.
 
     Returns the process exit code (0, or 1 for a configuration error).
     """
     signals: list[int] = []
 
     def on_signal(signum: int, frame) -> None:
-        # rclpy's handlers pass the signal on to this one. A KeyboardInterrupt raised while
-        # the EventsExecutor hands a callback its argument reaches spin_once as pybind11's
-        # RuntimeError "Unable to convert call argument" (seen once in CI, on SIGINT).
+        # Only noted: the loop ends after the callback in progress, on a context still up.
+        # rclpy's own handlers shut the context down from their thread under a running
+        # callback, whose publish then fails, and a KeyboardInterrupt raised in a callback
+        # fails it too; the EventsExecutor logs either as FATAL with a stack (seen on SIGTERM).
+        # A second signal interrupts as usual: a stuck shutdown (a bag's close) still ends.
         signals.append(signum)
-        if signum == signal.SIGINT:
-            raise KeyboardInterrupt
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, on_signal)  # before rclpy.init, which chains to it
-    rclpy.init(args=args)
+        signal.signal(signum, on_signal)
     node = executor = None
     try:
         node = node_class()
         # EventsExecutor: a message hop in a quarter of the SingleThreadedExecutor's time,
-        # which is most of a lockstep period. Its spin() ignores SIGINT; a spin_once loop
-        # does not.
+        # which is most of a lockstep period. A signal's handler runs once spin_once returns.
         executor = executor_class()
         executor.add_node(node)
-        while rclpy.ok():
+        while rclpy.ok() and not signals:
             executor.spin_once(timeout_sec=0.1)
-    except (KeyboardInterrupt, ExternalShutdownException):
+    except ExternalShutdownException:
         pass
-    except Exception as error:
-        if signals or not rclpy.ok():
-            pass  # a signal landed inside a callback, or shut the context under one
-        elif isinstance(error, (ValueError, ParameterException)):
-            rclpy.logging.get_logger(name).fatal(f'bad configuration: {error}')
-            return 1
-        else:
-            raise
+    except (ValueError, ParameterException) as error:
+        rclpy.logging.get_logger(name).fatal(f'bad configuration: {error}')
+        return 1
     finally:
         # The executor first: an EventsExecutor torn down by the garbage collector after its
         # node's entities are gone aborts the process ('Destroying callback manager with
@@ -198,11 +194,5 @@ def run_node(node_class: type[Node], name: str, args: list[str] | None = None,
             executor.shutdown()
         if node is not None:
             node.destroy_node()
-        try:
-            rclpy.try_shutdown()
-        except _rclpy.RCLError:
-            # rclpy's signal handler shuts the context down on its own thread: between
-            # try_shutdown's check and its shutdown (seen once in CI, on SIGINT).
-            if not signals:
-                raise
+        rclpy.try_shutdown()
     return 0
