@@ -48,6 +48,15 @@ def _parameter_argument(name: str, value: Any) -> str:
     return f'{name}:={text}'
 
 
+_PARTICIPANT_PROFILE = """<?xml version="1.0" encoding="UTF-8"?>
+<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <participant profile_name="swivel_car_node" is_default_profile="true">
+    <rtps><participantID>{participant_id}</participantID></rtps>
+  </participant>
+</profiles>
+"""
+
+
 class NodeProcess:
     """
     A node executable running in its own process.
@@ -65,13 +74,29 @@ class NodeProcess:
         ``-p name:=value`` overrides.
     params_file : path, optional
         A ``--params-file``.
+    participant_id : int, optional
+        Fast DDS participant id (0-31: rmw_fastrtps' localhost discovery looks for no more),
+        by default the lowest free one. A node started again after a crash must not take the
+        dead one's: Fast DDS 2.14 names a participant's shared memory port after its id, and
+        peers that kept the dead port open may never reach the new one (eProsima/Fast-DDS#5053).
 
     """
 
     def __init__(self, package: str, executable: str, domain_id: int,
                  parameters: Mapping[str, Any] | None = None,
-                 params_file: Path | None = None, extra_args: Iterable[str] = ()) -> None:
+                 params_file: Path | None = None, extra_args: Iterable[str] = (),
+                 participant_id: int | None = None) -> None:
         self.name = f'{package}/{executable}'
+        environment = ros_environment(domain_id)
+        self._profile: Path | None = None
+        if participant_id is not None:
+            if not 0 <= participant_id < 32:
+                raise ValueError(f'participant_id must be in [0, 32), got {participant_id}')
+            with tempfile.NamedTemporaryFile('w', prefix=f'{executable}-', suffix='.xml',
+                                             delete=False) as profile:
+                profile.write(_PARTICIPANT_PROFILE.format(participant_id=participant_id))
+            self._profile = Path(profile.name)
+            environment['FASTRTPS_DEFAULT_PROFILES_FILE'] = profile.name
         command = [str(executable_path(package, executable)), *extra_args, '--ros-args']
         if params_file is not None:
             command += ['--params-file', str(params_file)]
@@ -81,7 +106,7 @@ class NodeProcess:
             prefix=f'{executable}-', suffix='.log', delete=False)
         self._final_output: str | None = None
         self.process = subprocess.Popen(
-            command, env=ros_environment(domain_id), stdout=self.log,
+            command, env=environment, stdout=self.log,
             stderr=subprocess.STDOUT, start_new_session=True)
 
     def output(self) -> str:
@@ -95,6 +120,8 @@ class NodeProcess:
         self._final_output = self.output()
         self.log.close()
         Path(self.log.name).unlink(missing_ok=True)
+        if self._profile is not None:
+            self._profile.unlink(missing_ok=True)
 
     def running(self) -> bool:
         return self.process.poll() is None
@@ -129,14 +156,16 @@ def config_path(package: str, file_name: str) -> Path:
 
 
 def start_node(package: str, executable: str, domain_id: int,
-               parameters: Mapping[str, Any]) -> NodeProcess:
+               parameters: Mapping[str, Any], participant_id: int | None = None) -> NodeProcess:
     """
     Start an installed node with its package's parameter file and ``parameters`` on top.
 
-    The file is share/<package>/config/<executable>.yaml.
+    The file is share/<package>/config/<executable>.yaml; ``participant_id`` as for
+    `NodeProcess`.
     """
     return NodeProcess(package, executable, domain_id, parameters,
-                       params_file=config_path(package, f'{executable}.yaml'))
+                       params_file=config_path(package, f'{executable}.yaml'),
+                       participant_id=participant_id)
 
 
 def lockstep_parameters(executable: str, lockstep_timeout: float,

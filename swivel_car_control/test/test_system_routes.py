@@ -23,7 +23,7 @@ from nav_msgs.msg import Odometry
 import pytest
 import rclpy
 from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from std_srvs.srv import Empty
 from swivel_car_control.benchmark import routes, Segment
 from swivel_car_control.test.test_system import _seconds, _yaw
@@ -49,7 +49,7 @@ class RouteDriver:
 
     def __init__(self, context: Context) -> None:
         self.node = rclpy.create_node('route_driver', context=context)
-        self.executor = SingleThreadedExecutor(context=context)
+        self.executor = EventsExecutor(context=context)
         self.executor.add_node(self.node)
         self.truth: dict[float, Odometry] = {}  # by stamp [s]
         self.odom: dict[float, Odometry] = {}
