@@ -21,6 +21,13 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 INSTALL_DIR = Path(os.environ.get('SWIVEL_CAR_INSTALL', REPO_ROOT / 'ros2_ws' / 'install'))
 
 
+# Fast DDS 2.14's shared memory transport does not survive a peer killed with kill -9: a port
+# the dead process was writing into, or one named after its reused participant id, stays
+# unreachable (eProsima/Fast-DDS#5053, #5469). Over this profile a node uses UDP on 127.0.0.1
+# only, discovering peers there as rmw_fastrtps' LOCALHOST range does.
+LOOPBACK_UDP_PROFILE = Path(__file__).resolve().with_name('fastdds_loopback_udp.xml')
+
+
 def ros_environment(domain_id: int) -> dict[str, str]:
     """Return the environment for a node process on ``domain_id``, heard only on this host."""
     env = dict(os.environ)
@@ -48,15 +55,6 @@ def _parameter_argument(name: str, value: Any) -> str:
     return f'{name}:={text}'
 
 
-_PARTICIPANT_PROFILE = """<?xml version="1.0" encoding="UTF-8"?>
-<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
-  <participant profile_name="swivel_car_node" is_default_profile="true">
-    <rtps><participantID>{participant_id}</participantID></rtps>
-  </participant>
-</profiles>
-"""
-
-
 class NodeProcess:
     """
     A node executable running in its own process.
@@ -74,29 +72,22 @@ class NodeProcess:
         ``-p name:=value`` overrides.
     params_file : path, optional
         A ``--params-file``.
-    participant_id : int, optional
-        Fast DDS participant id (0-31: rmw_fastrtps' localhost discovery looks for no more),
-        by default the lowest free one. A node started again after a crash must not take the
-        dead one's: Fast DDS 2.14 names a participant's shared memory port after its id, and
-        peers that kept the dead port open may never reach the new one (eProsima/Fast-DDS#5053).
+    loopback_udp : bool
+        Talk over UDP on 127.0.0.1 only (``LOOPBACK_UDP_PROFILE``), not over Fast DDS's
+        shared memory, for a node that may be killed with kill -9 (see that profile).
 
     """
 
     def __init__(self, package: str, executable: str, domain_id: int,
                  parameters: Mapping[str, Any] | None = None,
                  params_file: Path | None = None, extra_args: Iterable[str] = (),
-                 participant_id: int | None = None) -> None:
+                 loopback_udp: bool = False) -> None:
         self.name = f'{package}/{executable}'
         environment = ros_environment(domain_id)
-        self._profile: Path | None = None
-        if participant_id is not None:
-            if not 0 <= participant_id < 32:
-                raise ValueError(f'participant_id must be in [0, 32), got {participant_id}')
-            with tempfile.NamedTemporaryFile('w', prefix=f'{executable}-', suffix='.xml',
-                                             delete=False) as profile:
-                profile.write(_PARTICIPANT_PROFILE.format(participant_id=participant_id))
-            self._profile = Path(profile.name)
-            environment['FASTRTPS_DEFAULT_PROFILES_FILE'] = profile.name
+        if loopback_udp:
+            # rmw_fastrtps' LOCALHOST range adds shared memory whatever the profile says.
+            environment['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'SYSTEM_DEFAULT'
+            environment['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(LOOPBACK_UDP_PROFILE)
         command = [str(executable_path(package, executable)), *extra_args, '--ros-args']
         if params_file is not None:
             command += ['--params-file', str(params_file)]
@@ -120,8 +111,6 @@ class NodeProcess:
         self._final_output = self.output()
         self.log.close()
         Path(self.log.name).unlink(missing_ok=True)
-        if self._profile is not None:
-            self._profile.unlink(missing_ok=True)
 
     def running(self) -> bool:
         return self.process.poll() is None
@@ -156,16 +145,16 @@ def config_path(package: str, file_name: str) -> Path:
 
 
 def start_node(package: str, executable: str, domain_id: int,
-               parameters: Mapping[str, Any], participant_id: int | None = None) -> NodeProcess:
+               parameters: Mapping[str, Any], loopback_udp: bool = False) -> NodeProcess:
     """
     Start an installed node with its package's parameter file and ``parameters`` on top.
 
-    The file is share/<package>/config/<executable>.yaml; ``participant_id`` as for
+    The file is share/<package>/config/<executable>.yaml; ``loopback_udp`` as for
     `NodeProcess`.
     """
     return NodeProcess(package, executable, domain_id, parameters,
                        params_file=config_path(package, f'{executable}.yaml'),
-                       participant_id=participant_id)
+                       loopback_udp=loopback_udp)
 
 
 def lockstep_parameters(executable: str, lockstep_timeout: float,
