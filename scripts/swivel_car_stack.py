@@ -107,7 +107,9 @@ class NodeProcess:
         return Path(self.log.name).read_text(errors='replace')
 
     def _forget_log(self) -> None:
-        """Keep the output of the ended process in memory and delete its log file."""
+        """Keep the output of the ended process in memory and delete its log file, once."""
+        if self._final_output is not None:
+            return
         self._final_output = self.output()
         self.log.close()
         Path(self.log.name).unlink(missing_ok=True)
@@ -124,16 +126,14 @@ class NodeProcess:
             except subprocess.TimeoutExpired:
                 os.killpg(self.process.pid, signal.SIGKILL)
                 self.process.wait()
-        if self._final_output is None:
-            self._forget_log()
+        self._forget_log()
         return self.process.returncode
 
     def kill(self) -> None:
         """SIGKILL, as a crash would end it."""
         os.killpg(self.process.pid, signal.SIGKILL)
         self.process.wait()
-        if self._final_output is None:
-            self._forget_log()
+        self._forget_log()
 
 
 def config_path(package: str, file_name: str) -> Path:
