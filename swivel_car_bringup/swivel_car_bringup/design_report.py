@@ -20,7 +20,10 @@ every lower height of the grid climbed too. The geometry sweeps are searched upw
 point's next heights run only while every lower height passed for the front wheels (the whole
 car cannot be up where its front is not), ``LOOKAHEAD`` heights at a time. The mass layout
 sweep runs its whole grid. Where the results name a change of design, that design is
-searched upward too before it is recommended (the sweeps change one thing at a time).
+searched upward too (the sweeps change one thing at a time), and it is climbed beside the default
+where the planner is used: ``room.yaml``, the climb benchmark's room (steps 0.2-1 m ahead, faces
+0.8-2 m wide), every height of its grid. The change is recommended only if it gets the whole car
+up at least as many of those requests as the default does.
 
 The results file is kept between runs: a trial's row is its configuration and request, not
 the code's revision (the page lists the revisions it read). Delete it to measure new code.
@@ -54,6 +57,7 @@ from swivel_car_model.description import CarDescription
 matplotlib.use('Agg')
 GEOMETRY = {'phi': 26, 'h': 27, 'l': 28, 'r': 29}  # field -> the thesis' figure
 LAYOUT = 'mass_layout'
+ROOM = 'room'  # the sweep of the planner's everyday room, for the default and the proposal
 PASS_FRACTION = 0.75  # [1] of a height's trials that must climb: 3 of 4
 LOOKAHEAD = 2  # heights per design point and round of the upward search
 LAYOUT_MARGIN = 2  # climbs more than the default's, of the whole layout grid, to recommend
@@ -195,8 +199,8 @@ def changes(robot: CarDescription, default: CarDescription) -> dict[str, Any]:
             if getattr(default, item.name) != getattr(robot, item.name)}
 
 
-def layout_score(s: Search) -> int:
-    """All four wheels on top, summed over the layout grid's trials."""
+def grid_climbs(s: Search) -> int:
+    """All four wheels on top, summed over the trials of every height run."""
     return sum(h.four for h in s.heights)
 
 
@@ -212,9 +216,9 @@ def proposal(geometry: list[Search], layout: list[Search],
     proposed = changes(best.point.robot, default)
     layout_default = [s for s in layout if not changes(s.point.robot, default)]
     if layout_default:
-        top = max(layout, key=lambda s: (layout_score(s),
+        top = max(layout, key=lambda s: (grid_climbs(s),
                                          -len(changes(s.point.robot, default))))
-        if layout_score(top) >= layout_score(layout_default[0]) + LAYOUT_MARGIN:
+        if grid_climbs(top) >= grid_climbs(layout_default[0]) + LAYOUT_MARGIN:
             proposed.update(changes(top.point.robot, default))
     return proposed
 
@@ -327,7 +331,7 @@ def layout_section(searches: list[Search], default: CarDescription) -> list[str]
         lines.append('| ' + ' | '.join(_fmt(label[f]) for f in fields_) + default_mark
                      + f' | {s.point.robot.com_fraction:.0%} | '
                      + ' | '.join(f'{h.four}/{h.trials}' for h in s.heights)
-                     + f' | {layout_score(s)}/{sum(h.trials for h in s.heights)} |')
+                     + f' | {grid_climbs(s)}/{sum(h.trials for h in s.heights)} |')
     return lines + ['']
 
 
@@ -348,29 +352,38 @@ class Campaign:
         self.sweeps[LAYOUT] = load_sweep(sweep_path(LAYOUT))
         self.points = {name: points(plan_trials(sweep), sweep.count)
                        for name, sweep in self.sweeps.items()}
+        self.room = load_sweep(sweep_path(ROOM))
         self.default = CarDescription()
+        self.planned = False  # the proposal's own points, once the sweeps are done
         self.confirm: Point | None = None
+        self.room_points: list[Point] = []  # the default's, then the proposal's
 
     def searches(self, rows) -> dict[str, list[Search]]:
         found = {name: [search(p, rows, upward=name != LAYOUT) for p in pts]
                  for name, pts in self.points.items()}
         if self.confirm is not None:
             found['confirm'] = [search(self.confirm, rows)]
+        found[ROOM] = [search(p, rows, upward=False) for p in self.room_points]
         return found
 
     def plan_confirmation(self, found: dict[str, list[Search]]) -> None:
         """
-        Plan the proposed design as a point of its own once the sweeps are done.
+        Plan the proposed design's own points once the sweeps are done.
 
-        Nothing is planned if a geometry sweep measured it already.
+        Its upward search in the sweeps' room, unless a geometry sweep measured it already,
+        and the room sweep for it and for the default.
         """
+        self.planned = True
         geometry = [s for name in GEOMETRY for s in found[f'design_{name}']]
         proposed = proposal(geometry, found[LAYOUT], self.default)
-        if not proposed or any(changes(s.point.robot, self.default) == proposed
-                               for s in geometry):
+        if not proposed:
             return
-        sweep = replace(self.sweeps['design_phi'], design={k: (v,) for k, v in proposed.items()})
-        self.confirm = points(plan_trials(sweep), sweep.count)[0]
+        design = {k: (v,) for k, v in proposed.items()}
+        if not any(changes(s.point.robot, self.default) == proposed for s in geometry):
+            sweep = replace(self.sweeps['design_phi'], design=design)
+            self.confirm = points(plan_trials(sweep), sweep.count)[0]
+        self.room_points = [points(plan_trials(replace(self.room, design=d)), self.room.count)[0]
+                            for d in ({}, design)]
 
     def run(self, workers: int | None, address: str | None) -> int:
         """Climb until every search is done; returns how many climbs ran."""
@@ -383,10 +396,9 @@ class Campaign:
                 todo = {spec.key(): spec for group in found.values() for s in group
                         for height in s.todo for spec in s.point.trials[height]
                         if spec.key() not in rows}
-                if not todo and self.confirm is None:
+                if not todo and not self.planned:
                     self.plan_confirmation(found)
-                    if self.confirm is not None:
-                        continue
+                    continue
                 if not todo:
                     return ran
                 if at_once is None:
@@ -416,6 +428,7 @@ def write_page(docs: Path, campaign: Campaign, rows, fidelity_rows, ran: int, wa
         'Generated by `python -m swivel_car_bringup.design_report` (console script '
         '`design_report`; do not edit by hand). It climbs the sweep files '
         '`swivel_car_bringup/config/campaigns/design_{phi,h,l,r}.yaml` and `mass_layout.yaml` '
+        '(and `room.yaml` for the recommendation) '
         "through the campaign command's machinery (in-process stack, Ray, one row per trial "
         f'in `{campaign.results}`, resumable), measures the fidelity table and writes this page '
         'and `docs/figures/physics_fig26-29.png`.', '',
@@ -459,11 +472,30 @@ def write_page(docs: Path, campaign: Campaign, rows, fidelity_rows, ran: int, wa
               "thesis' Table 2 parameters).", '',
               '| claim | physics | model | thesis |', '|---|---|---|---|']
     lines += [f'| {r.claim} | {r.physics} | {r.model} | {r.thesis} |' for r in fidelity_rows]
-    lines += [''] + recommendation_section(found, default, geometry)
+    lines += [''] + recommendation_section(found, default, geometry, campaign.room)
     (docs / 'design_campaign.md').write_text('\n'.join(lines) + '\n')
 
 
-def recommendation_section(found, default: CarDescription, geometry: list[Search]) -> list[str]:
+def adopt(room: list[Search]) -> bool:
+    """Whether the proposal (``room[1]``) gets the whole car up as often as the default."""
+    return grid_climbs(room[1]) >= grid_climbs(room[0])
+
+
+def room_table(room: list[Search]) -> list[str]:
+    """Per height of the room sweep: whole car on top and refused as placed, of the trials."""
+    lines = ['| height | default: whole car on top | refused | proposal: whole car on top | '
+             'refused |', '|---|---|---|---|---|']
+    for default, proposed in zip(room[0].heights, room[1].heights):
+        lines.append(f'| {_cm(default.height)} | {default.four}/{default.trials} | '
+                     f'{default.refused} | {proposed.four}/{proposed.trials} | '
+                     f'{proposed.refused} |')
+    total = [(grid_climbs(s), s.climbs, sum(h.refused for h in s.heights)) for s in room]
+    return lines + [f'| all | **{total[0][0]}/{total[0][1]}** | {total[0][2]} | '
+                    f'**{total[1][0]}/{total[1][1]}** | {total[1][2]} |']
+
+
+def recommendation_section(found, default: CarDescription, geometry: list[Search],
+                           room_sweep: Sweep) -> list[str]:
     base = next(s for s in geometry if not changes(s.point.robot, default))
     candidates = geometry + found.get('confirm', [])
     best = max(candidates, key=lambda s: _rank(s, default))
@@ -473,27 +505,36 @@ def recommendation_section(found, default: CarDescription, geometry: list[Search
              f'changes. The default: whole car {_cm(base.four)}, front wheels '
              f'{_cm(base.front)}. The mass layout sweep changes the default when a layout '
              f'climbs at least {LAYOUT_MARGIN} more of its grid than the default layout; a '
-             'combined change is searched upward on its own before it is recommended.', '']
+             'combined change is searched upward on its own, then climbed beside the default '
+             "where the planner is used (`room.yaml`: the climb benchmark's room, "
+             f'{_ranges(room_sweep)}, every height, a refused request counting as not climbed) '
+             'and recommended only if it gets the whole car up at least as often there.', '']
     if not change:
-        lines.append('**Keep the default**: no swept design climbs higher.')
-    else:
-        lines += ['**Change** ' + ', '.join(
-            f'`{name}` from {_fmt(getattr(default, name))} to {_fmt(value)}'
-            for name, value in change.items())
-            + f' in `CarDescription`: whole car {_cm(best.four)} (default {_cm(base.four)}), '
-            f'front wheels {_cm(best.front)} (default {_cm(base.front)}), centre of mass at '
-            f'{best.point.robot.com_fraction:.0%} of the wheelbase, I_s '
-            f'{best.point.robot.inertia_about_rear_axle:.2f} kg m^2, {best.climbs} climbs. '
-            f'Per height [cm], front/whole car of {best.point.count}: {_heights_run(best)}.',
-            '',
-            f'Each height is {best.point.count} randomised trials: confirm on more draws '
-            f'before adopting it (`python -m swivel_car_bringup.climb_benchmark '
-            + ' '.join(f'--set {name}={_fmt(value)}' for name, value in change.items())
-            + f' --max-height {best.four + 0.02:.2f} --trials 8`).', '',
-            "Not changed here: the demo, the planner's capability table and many tests "
-            'depend on the default; the capability table must be remeasured with it '
-            '(`climb_benchmark --write-capability`).']
-    return lines + ['']
+        return lines + ['**Keep the default**: no swept design climbs higher.', '']
+    named = ', '.join(f'`{name}` from {_fmt(getattr(default, name))} to {_fmt(value)}'
+                      for name, value in change.items())
+    room = found[ROOM]
+    lines += [f'The sweeps point to {named}: whole car {_cm(best.four)} (default '
+              f'{_cm(base.four)}), front wheels {_cm(best.front)} (default {_cm(base.front)}), '
+              f'centre of mass at {best.point.robot.com_fraction:.0%} of the wheelbase, I_s '
+              f'{best.point.robot.inertia_about_rear_axle:.2f} kg m^2, {best.climbs} climbs. '
+              f'Per height [cm], front/whole car of {best.point.count}: {_heights_run(best)}.',
+              '', 'Where the planner is used, default beside the proposal:', '',
+              *room_table(room), '']
+    if adopt(room):
+        return lines + [
+            f"**Change** {named} in `CarDescription`, then remeasure the planner's capability "
+            'table (`climb_benchmark --write-capability`), which the demo and the tests read.',
+            '']
+    refused = [sum(h.refused for h in s.heights) for s in room]
+    failed = [s.climbs - grid_climbs(s) - r for s, r in zip(room, refused)]
+    return lines + [
+        f'**Keep the default.** The change climbs higher only with the room of the sweeps; '
+        f'where the planner is used it gets the whole car up {grid_climbs(room[1])} of '
+        f"{room[1].climbs} requests against the default's {grid_climbs(room[0])}: the planner "
+        f'refuses {refused[1]} of them as placed (default {refused[0]}: the step too close or '
+        f'its face too narrow for the approach that design needs), and {failed[1]} climbs it '
+        f'tries leave a wheel below (default {failed[0]}).', '']
 
 
 def main(argv: list[str] | None = None) -> None:

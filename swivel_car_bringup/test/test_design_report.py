@@ -12,7 +12,7 @@ import pytest
 from swivel_car_bringup import design_report
 from swivel_car_bringup.campaign import parse_sweep, plan_trials
 from swivel_car_bringup.design_report import (
-    changes, layout_score, LOOKAHEAD, points, proposal, Search, search)
+    adopt, changes, grid_climbs, LOOKAHEAD, points, proposal, Search, search)
 from swivel_car_model.description import CarDescription
 import yaml
 
@@ -81,12 +81,20 @@ def test_the_proposal_takes_the_highest_whole_car_then_front_and_needs_a_layout_
     assert proposal(geometry, layout[:2], default) == {'h': 0.2}  # 11 is not 10 + 2
     assert proposal([geometry[0], geometry[3]], layout[:2], default) == {}  # a tie: default
     assert changes(layout[2].point.robot, default) == {'rear_differential': 'locked'}
-    assert layout_score(layout[2]) == 12
+    assert grid_climbs(layout[2]) == 12
+
+
+def test_the_proposal_is_adopted_only_if_it_climbs_as_often_where_the_planner_is_used():
+    default, proposed = _search({}, 0.07, 0.2, 5), _search({'r': 0.125}, 0.1, 0.2, 5)
+    assert adopt([default, proposed])  # a tie keeps the proposal: it climbs higher elsewhere
+    assert not adopt([default, _search({'r': 0.125}, 0.1, 0.2, 4)])
+    lines = design_report.room_table([default, proposed])
+    assert lines[2] == '| 6 cm | 5/6 | 0 | 5/6 | 0 |' and lines[-1].startswith('| all | **5/6**')
 
 
 def test_a_bad_sweep_file_is_one_line_naming_the_field_and_nothing_is_written(
         tmp_path, monkeypatch, capsys):
-    for name in ('design_phi', 'design_h', 'design_l', 'design_r', 'mass_layout'):
+    for name in ('design_phi', 'design_h', 'design_l', 'design_r', 'mass_layout', 'room'):
         data = {'design': {'h': [0.15, -0.1]} if name == 'design_h' else {},
                 'trials': {'heights': [0.02]}}
         (tmp_path / f'{name}.yaml').write_text(yaml.safe_dump(data))

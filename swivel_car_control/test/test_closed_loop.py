@@ -12,6 +12,7 @@ import pytest
 
 from swivel_car_control.benchmark import ClosedLoop, routes
 from swivel_car_control.core.controller import ControllerConfig
+from swivel_car_model.description import CarDescription
 
 
 @pytest.fixture
@@ -105,21 +106,32 @@ def test_swivel_step_response(loop, start, target):
     assert outside[-1] + 1 < len(trace), 'did not settle within 4 s of sim time'
 
 
-@pytest.mark.parametrize('name', ['straight_5m', 'turn_on_the_spot'])
+ROUTES = list(routes(CarDescription().model_params()))
+
+
+@pytest.mark.parametrize('name', ROUTES)
 def test_odometry_on_standard_routes(name):
     """
-    Check the odometry's end-pose error on a standard route, as a share of the distance.
+    Check the odometry's end-pose error on every standard route, as a share of the distance.
 
     The offset model within 1.5 % (the sim's wheel slip in tight turns costs it up to ~1 %),
     with the rear-axle yaw rate too (the rear wheels carry 53 % of the weight and slip in a
     turn on the spot: 1.1 %), and the offset model's heading far better than the plain
-    tricycle's where the swivel is large.
+    tricycle's where the swivel is large. The sweep at standstill moves base_link 11 cm, too
+    little to divide by: with the weight forward the rear axle skids sideways as the swivel
+    turns, which wheel encoders cannot see (4.8 cm measured). Through the executables:
+    test_system_routes.py.
     """
     loop = ClosedLoop()
     try:
         result = loop.drive(name, routes(loop.p)[name])
     finally:
         loop.close()
+    print(f'{name}: {result.distance:.3f} m, end error {result.ours[0]:.4f} m')
+    if name == 'swivel_sweep_standstill':
+        assert result.ours[0] < 0.06
+        return
+    assert result.distance > 1.0
     assert result.ours[0] / result.distance < 0.015
     assert result.rear[0] / result.distance < 0.015
     if name == 'turn_on_the_spot':
