@@ -356,7 +356,7 @@ class Campaign:
         self.default = CarDescription()
         self.planned = False  # the proposal's own points, once the sweeps are done
         self.confirm: Point | None = None
-        self.room_points: list[Point] = []  # the default's, then the proposal's
+        self.room_points: list[Point] = []  # the default's, then the recommended change's
 
     def searches(self, rows) -> dict[str, list[Search]]:
         found = {name: [search(p, rows, upward=name != LAYOUT) for p in pts]
@@ -368,22 +368,26 @@ class Campaign:
 
     def plan_confirmation(self, found: dict[str, list[Search]]) -> None:
         """
-        Plan the proposed design's own points once the sweeps are done.
+        Plan the proposed design as a point of its own once the sweeps are done.
 
-        Its upward search in the sweeps' room, unless a geometry sweep measured it already,
-        and the room sweep for it and for the default.
+        Nothing is planned if a geometry sweep measured it already.
         """
         self.planned = True
         geometry = [s for name in GEOMETRY for s in found[f'design_{name}']]
         proposed = proposal(geometry, found[LAYOUT], self.default)
-        if not proposed:
+        if not proposed or any(changes(s.point.robot, self.default) == proposed
+                               for s in geometry):
             return
-        design = {k: (v,) for k, v in proposed.items()}
-        if not any(changes(s.point.robot, self.default) == proposed for s in geometry):
-            sweep = replace(self.sweeps['design_phi'], design=design)
-            self.confirm = points(plan_trials(sweep), sweep.count)[0]
-        self.room_points = [points(plan_trials(replace(self.room, design=d)), self.room.count)[0]
-                            for d in ({}, design)]
+        sweep = replace(self.sweeps['design_phi'], design={k: (v,) for k, v in proposed.items()})
+        self.confirm = points(plan_trials(sweep), sweep.count)[0]
+
+    def plan_room(self, found: dict[str, list[Search]]) -> None:
+        """Plan the room sweep for the recommended change and the default, if there is one."""
+        change = changes(recommended(found, self.default).point.robot, self.default)
+        if change:
+            self.room_points = [
+                points(plan_trials(replace(self.room, design=design)), self.room.count)[0]
+                for design in ({}, {k: (v,) for k, v in change.items()})]
 
     def run(self, workers: int | None, address: str | None) -> int:
         """Climb until every search is done; returns how many climbs ran."""
@@ -399,6 +403,10 @@ class Campaign:
                 if not todo and not self.planned:
                     self.plan_confirmation(found)
                     continue
+                if not todo and not self.room_points:
+                    self.plan_room(found)
+                    if self.room_points:
+                        continue
                 if not todo:
                     return ran
                 if at_once is None:
@@ -494,11 +502,16 @@ def room_table(room: list[Search]) -> list[str]:
                     f'**{total[1][0]}/{total[1][1]}** | {total[1][2]} |']
 
 
+def recommended(found: dict[str, list[Search]], default: CarDescription) -> Search:
+    """Return the best of the geometry points and the confirmed proposal, by ``_rank``."""
+    candidates = [s for name in GEOMETRY for s in found[f'design_{name}']]
+    return max(candidates + found.get('confirm', []), key=lambda s: _rank(s, default))
+
+
 def recommendation_section(found, default: CarDescription, geometry: list[Search],
                            room_sweep: Sweep) -> list[str]:
     base = next(s for s in geometry if not changes(s.point.robot, default))
-    candidates = geometry + found.get('confirm', [])
-    best = max(candidates, key=lambda s: _rank(s, default))
+    best = recommended(found, default)
     change = changes(best.point.robot, default)
     lines = ['## The recommended default design', '',
              f"Ranked by the whole car's highest step, then the front wheels', then the fewest "

@@ -84,6 +84,16 @@ def test_the_proposal_takes_the_highest_whole_car_then_front_and_needs_a_layout_
     assert grid_climbs(layout[2]) == 12
 
 
+def test_the_recommendation_is_the_best_geometry_point_or_the_confirmed_proposal():
+    geometry = {f'design_{name}': [_search({}, 0.08, 0.22)] for name in design_report.GEOMETRY}
+    geometry['design_r'].append(_search({'r': 0.1}, 0.09, 0.20))
+    assert design_report.recommended(geometry, CarDescription()).point.robot.r == 0.1
+    confirmed = _search({'r': 0.1, 'rear_differential': 'locked'}, 0.1, 0.20)
+    best = design_report.recommended({**geometry, 'confirm': [confirmed]}, CarDescription())
+    expected = {'r': 0.1, 'rear_differential': 'locked'}
+    assert changes(best.point.robot, CarDescription()) == expected
+
+
 def test_the_proposal_is_adopted_only_if_it_climbs_as_often_where_the_planner_is_used():
     default, proposed = _search({}, 0.07, 0.2, 5), _search({'r': 0.125}, 0.1, 0.2, 5)
     assert adopt([default, proposed])  # a tie keeps the proposal: it climbs higher elsewhere
