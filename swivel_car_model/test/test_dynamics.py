@@ -174,8 +174,10 @@ def test_swivel_pose_drift_through_zero_is_two_moves():
 
 
 def test_bigger_shaft_gives_bigger_yaw_drift():
-    small = d.simulate_planar_swivel(dataclasses.replace(P, h=0.1), rate=1.0, samples=2)
-    big = d.simulate_planar_swivel(dataclasses.replace(P, h=0.2), rate=1.0, samples=2)
+    # Half the range shows it at a tenth of the cost: the integration stiffens towards pi/2.
+    small = d.simulate_planar_swivel(dataclasses.replace(P, h=0.1), 0.0, 0.7, rate=1.0,
+                                     samples=2)
+    big = d.simulate_planar_swivel(dataclasses.replace(P, h=0.2), 0.0, 0.7, rate=1.0, samples=2)
     assert abs(big.yaw[-1]) > abs(small.yaw[-1])
 
 
