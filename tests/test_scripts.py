@@ -25,7 +25,7 @@ def test_a_script_imports_and_answers_help(name, capsys):
 
 
 def test_a_node_process_keeps_its_output_and_deletes_its_log_once_stopped():
-    # Every test run starts some 250 node processes: their logs must not pile up in /tmp.
+    # Every test run starts some 60 node processes: their logs must not pile up in /tmp.
     process = start_node('swivel_car_sim', 'sim_node', next_domain_id(), {})
     log = Path(process.log.name)
     deadline = time.monotonic() + 60.0

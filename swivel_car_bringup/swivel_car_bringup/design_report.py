@@ -204,6 +204,11 @@ def grid_climbs(s: Search) -> int:
     return sum(h.four for h in s.heights)
 
 
+def grid_refusals(s: Search) -> int:
+    """Count the requests the planner refused as placed, over the trials of every height run."""
+    return sum(h.refused for h in s.heights)
+
+
 def proposal(geometry: list[Search], layout: list[Search],
              default: CarDescription) -> dict[str, Any]:
     """
@@ -331,7 +336,7 @@ def layout_section(searches: list[Search], default: CarDescription) -> list[str]
         lines.append('| ' + ' | '.join(_fmt(label[f]) for f in fields_) + default_mark
                      + f' | {s.point.robot.com_fraction:.0%} | '
                      + ' | '.join(f'{h.four}/{h.trials}' for h in s.heights)
-                     + f' | {grid_climbs(s)}/{sum(h.trials for h in s.heights)} |')
+                     + f' | {grid_climbs(s)}/{s.climbs} |')
     return lines + ['']
 
 
@@ -497,7 +502,7 @@ def room_table(room: list[Search]) -> list[str]:
         lines.append(f'| {_cm(default.height)} | {default.four}/{default.trials} | '
                      f'{default.refused} | {proposed.four}/{proposed.trials} | '
                      f'{proposed.refused} |')
-    total = [(grid_climbs(s), s.climbs, sum(h.refused for h in s.heights)) for s in room]
+    total = [(grid_climbs(s), s.climbs, grid_refusals(s)) for s in room]
     return lines + [f'| all | **{total[0][0]}/{total[0][1]}** | {total[0][2]} | '
                     f'**{total[1][0]}/{total[1][1]}** | {total[1][2]} |']
 
@@ -539,7 +544,7 @@ def recommendation_section(found, default: CarDescription, geometry: list[Search
             f"**Change** {named} in `CarDescription`, then remeasure the planner's capability "
             'table (`climb_benchmark --write-capability`), which the demo and the tests read.',
             '']
-    refused = [sum(h.refused for h in s.heights) for s in room]
+    refused = [grid_refusals(s) for s in room]
     failed = [s.climbs - grid_climbs(s) - r for s, r in zip(room, refused)]
     return lines + [
         f'**Keep the default.** The change climbs higher only with the room of the sweeps; '
