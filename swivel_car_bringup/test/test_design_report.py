@@ -102,18 +102,21 @@ def test_the_proposal_is_adopted_only_if_it_climbs_as_often_where_the_planner_is
     assert lines[2] == '| 6 cm | 5/6 | 0 | 5/6 | 0 |' and lines[-1].startswith('| all | **5/6**')
 
 
+@pytest.mark.parametrize('bad, data, message', [
+    ('design_h', {'design': {'h': [0.15, -0.1]}, 'trials': {'heights': [0.02]}},
+     'design h=-0.1: h must be > 0'),
+    ('room', {'trials': {'heights': [0.05], 'count': 0}},
+     'trials.count must be an integer >= 1, got 0')])
 def test_a_bad_sweep_file_is_one_line_naming_the_field_and_nothing_is_written(
-        tmp_path, monkeypatch, capsys):
+        tmp_path, monkeypatch, capsys, bad, data, message):
     for name in ('design_phi', 'design_h', 'design_l', 'design_r', 'mass_layout', 'room'):
-        data = {'design': {'h': [0.15, -0.1]} if name == 'design_h' else {},
-                'trials': {'heights': [0.02]}}
-        (tmp_path / f'{name}.yaml').write_text(yaml.safe_dump(data))
+        good = {'design': {}, 'trials': {'heights': [0.02]}}
+        (tmp_path / f'{name}.yaml').write_text(yaml.safe_dump(data if name == bad else good))
     monkeypatch.setattr(design_report, 'sweep_path', lambda name: tmp_path / f'{name}.yaml')
     results = tmp_path / 'out' / 'results.csv'
     with pytest.raises(SystemExit) as exit_:
         design_report.main(['--results', str(results), '--docs', str(tmp_path / 'docs')])
     assert exit_.value.code == 2
     err = capsys.readouterr().err
-    assert err.startswith('design_report: error: design h=-0.1: ') and err.count('\n') == 1
-    assert 'h must be > 0' in err, err
+    assert err.startswith(f'design_report: error: {message}') and err.count('\n') == 1, err
     assert not results.exists() and not (tmp_path / 'docs').exists()
