@@ -23,7 +23,7 @@ DESIGN_POSITIVE = [item.name for item in fields(CarDescription)
 PROCEDURE = [item.name for item in fields(PlannerConfig)]
 BAD_NUMBER = NON_FINITE | NOT_NUMERIC | at_most(-1e-9)
 # Checking a design builds the stack's installed configuration: tens of ms an example.
-FEW = settings(max_examples=20, deadline=None)
+FEW = settings(max_examples=20)
 
 
 def refused(data: dict) -> SweepError:

@@ -92,7 +92,7 @@ def test_zero_timeout_disables_the_deadman():
     assert out.drive_speed == pytest.approx(0.3 / P.r)
 
 
-@settings(deadline=None, max_examples=20)
+@settings(max_examples=20)
 @given(bad=st.sampled_from([math.nan, math.inf, -math.inf]), slot=st.integers(0, 2))
 def test_non_finite_cmd_vel_keeps_the_last_safe_command(bad, slot):
     controller = make(cmd_vel_timeout=0.0)

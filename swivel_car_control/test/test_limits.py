@@ -2,7 +2,7 @@
 
 import math
 
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, strategies as st
 import pytest
 
 from swivel_car_control.core.limits import SlewLimiter, steering_speed_scale
@@ -20,7 +20,6 @@ def test_slew_limiter_limits_value_and_rate():
     assert limiter.value == -1.0
 
 
-@settings(deadline=None)
 @given(targets=st.lists(st.floats(-10, 10), min_size=1, max_size=30),
        dt=st.floats(0.0, 0.1))
 def test_slew_limiter_never_exceeds_its_limits(targets, dt):

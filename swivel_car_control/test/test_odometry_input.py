@@ -92,7 +92,7 @@ def test_bad_gate_limits_are_refused(limits, max_gap):
 stamps = st.floats(-1e10, 1e10, allow_nan=False) | st.sampled_from([math.nan, math.inf])
 
 
-@settings(deadline=None, max_examples=300)
+@settings(max_examples=300)
 @given(st.lists(stamps, max_size=30))
 def test_what_is_integrated_follows_on_in_time_or_was_confirmed(sequence):
     """
@@ -133,7 +133,7 @@ bad_stamp = (st.floats(-1e10, 10.0 - 1e-6) | st.floats(11.0 + MAX_GAP, 2.0**31)
              | st.just(math.nan))
 
 
-@settings(deadline=None, max_examples=100)
+@settings(max_examples=100)
 @given(rates=st.lists(st.floats(-WHEEL_LIMIT / 2, WHEEL_LIMIT / 2), min_size=100,
                       max_size=100),
        where=st.integers(1, 99), velocity=bad_velocity, stamp=bad_stamp,

@@ -2,7 +2,7 @@
 
 import math
 
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, strategies as st
 import pytest
 
 from swivel_car_control.core.pid import PidConfig, SwivelPid
@@ -46,7 +46,6 @@ def test_output_clamp_and_anti_windup():
     assert out.i_term == pytest.approx(CONFIG.max_integral_torque)
 
 
-@settings(deadline=None)
 @given(set_point=st.floats(-2, 2), measured=st.floats(-2, 2), rate=st.floats(-10, 10))
 def test_torque_always_within_clamp(set_point, measured, rate):
     pid = SwivelPid(CONFIG)

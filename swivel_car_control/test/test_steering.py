@@ -2,7 +2,7 @@
 
 import math
 
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, strategies as st
 import pytest
 
 from swivel_car_control.core.steering import (
@@ -20,7 +20,6 @@ def test_straight_and_standstill():
     assert standstill.swivel is None and standstill.v == 0.0
 
 
-@settings(deadline=None)
 @given(v=st.floats(0.05, 0.5), curvature_fraction=st.floats(-1.0, 1.0))
 def test_reachable_arcs_are_met_exactly(v, curvature_fraction):
     omega = curvature_fraction * MAP.max_curvature * v

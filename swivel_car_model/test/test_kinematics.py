@@ -170,7 +170,7 @@ def test_swivel_for_steering_inverts_steering(p):
         assert k.steering_angle(p, scalar) == pytest.approx(value, abs=1e-11)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60)
 @given(phi=st.floats(0.05, 1.45).map(lambda v: v * (1 if v > 0.75 else -1)),
        h=st.floats(0.05, 0.3), theta2=st.floats(-math.pi / 2, math.pi / 2))
 def test_property_lift_is_a_contact_solution(phi, h, theta2):
@@ -182,7 +182,7 @@ def test_property_lift_is_a_contact_solution(phi, h, theta2):
     assert abs(state.steering) <= math.pi / 2 + 1e-12
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=40)
 @given(fraction=st.floats(0.0, 1.0))
 def test_property_swivel_for_step_is_smallest_clearing_angle(fraction):
     reach, _ = k.max_scalable_step(DEFAULT)
@@ -266,7 +266,7 @@ def test_scalar_in_scalar_out_and_shape_preserved():
     assert k.forward_kinematics(DEFAULT, np.zeros((2, 5))).o3.shape == (2, 5, 4, 4)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=40)
 @given(phi=st.floats(0.1, 1.4).map(lambda v: v if v > 0.75 else -v),
        h=st.floats(0.05, 0.3), fraction=st.floats(-1.0, 1.0))
 def test_property_swivel_for_steering_inverts_steering(phi, h, fraction):

@@ -17,7 +17,6 @@ angles = st.floats(-LIMIT, LIMIT, allow_nan=False)
 rates = st.floats(-3.0, 3.0, allow_nan=False)
 
 
-@settings(deadline=None)
 @given(v=st.floats(-2.0, 2.0), a=st.floats(0.1, 1.0), delta=st.floats(-1.2, 1.2))
 def test_without_offset_it_is_the_plain_tricycle(v, a, delta):
     omega = planar.offset_tricycle_yaw_rate(v, a, 0.0, 0.0, 0.0, delta)
@@ -50,7 +49,6 @@ def test_curvature_grows_monotonically_with_the_swivel():
     assert np.all(np.diff(curvature) > 0.0)
 
 
-@settings(deadline=None)
 @given(theta2=angles)
 def test_swivel_for_curvature_inverts_curvature_for_swivel(theta2):
     curvature = planar.curvature_for_swivel(P, theta2)
@@ -170,7 +168,7 @@ def test_odometry_reset_set_pose_and_wrap():
     assert (odometry.x, odometry.y, odometry.yaw, odometry.v) == (0.0, 0.0, 0.0, 0.0)
 
 
-@settings(deadline=None, max_examples=30)
+@settings(max_examples=30)
 @given(bad=st.sampled_from([math.nan, math.inf, -math.inf]),
        slot=st.integers(0, 3))
 def test_odometry_bad_input_changes_nothing(bad, slot):

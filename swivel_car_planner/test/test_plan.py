@@ -353,7 +353,7 @@ def test_bad_extent_is_an_invalid_request():
     assert validate_request(request(offset=99.0), CONFIG)[0] == ErrorCode.INVALID_REQUEST
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=30)
 @given(st.floats(0.005, 0.3), st.floats(-1.0, 1.0))
 def test_every_plan_keeps_its_margins_or_says_why_not(height, yaw):
     try:
