@@ -3,13 +3,16 @@ A bad parameter at start ends every node with one [FATAL] line naming it.
 
 A parameter of the wrong type or value: exit code 1 and no traceback (issue 12: before,
 rclpy's InvalidParameterTypeException, and any bad planner value); an integer where a number
-is due is that number.
+is due is that number. Each executable is started once with a bad value; the other bad values
+are given to the node class in this process, through the same command-line arguments: the
+executable's main turns what they raise into that one line.
 """
 
 import os
 import subprocess
 
 import pytest
+from rclpy.exceptions import ParameterException
 from rclpy.parameter import Parameter
 
 from swivel_car_control.controller_node import ControllerNode
@@ -19,24 +22,26 @@ from swivel_car_sim.sim_node import SimNode
 from swivel_car_testing import next_domain_id, REPO_ROOT
 
 INSTALL = REPO_ROOT / 'ros2_ws' / 'install'
-CASES = [
+EXECUTABLE_CASES = [
     ('swivel_car_sim', 'sim_node', 'lockstep', 'maybe'),
     ('swivel_car_control', 'controller_node', 'use_stamped', '7'),
     ('swivel_car_control', 'odometry_node', 'publish_rate', 'fast'),
     ('swivel_car_planner', 'planner_node', 'time_allowance', '[1.0]'),
-    ('swivel_car_sim', 'sim_node', 'body_mass', 'heavy'),
-    ('swivel_car_sim', 'sim_node', 'time_step', '-1.0'),
-    ('swivel_car_control', 'controller_node', 'lockstep_wait', 'long'),
-    ('swivel_car_control', 'controller_node', 'lockstep_cmd_vel', 'maybe'),
-    ('swivel_car_control', 'controller_node', 'kp', '.nan'),
-    ('swivel_car_planner', 'planner_node', 'body_mass', '-1.0'),
-    ('swivel_car_planner', 'planner_node', 'ready_timeout', '-1.0'),
-    ('swivel_car_planner', 'planner_node', 'ready_timeout', 'soon'),
-    ('swivel_car_planner', 'planner_node', 'approach_speed', '.nan'),
+]
+NODE_CASES = [
+    (SimNode, 'body_mass', 'heavy'),
+    (SimNode, 'time_step', '-1.0'),
+    (ControllerNode, 'lockstep_wait', 'long'),
+    (ControllerNode, 'lockstep_cmd_vel', 'maybe'),
+    (ControllerNode, 'kp', '.nan'),
+    (PlannerNode, 'body_mass', '-1.0'),
+    (PlannerNode, 'ready_timeout', '-1.0'),
+    (PlannerNode, 'ready_timeout', 'soon'),
+    (PlannerNode, 'approach_speed', '.nan'),
 ]
 
 
-@pytest.mark.parametrize('package, executable, name, value', CASES)
+@pytest.mark.parametrize('package, executable, name, value', EXECUTABLE_CASES)
 def test_a_wrong_type_at_start_is_one_fatal_line_and_exit_1(package, executable, name, value):
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
                ROS_DOMAIN_ID=str(next_domain_id()))
@@ -50,6 +55,17 @@ def test_a_wrong_type_at_start_is_one_fatal_line_and_exit_1(package, executable,
     assert 'Traceback' not in output
     fatal = [line for line in output.splitlines() if '[FATAL]' in line]
     assert len(fatal) == 1 and name in fatal[0], output
+
+
+@pytest.mark.parametrize('node_class, name, value', NODE_CASES,
+                         ids=lambda v: getattr(v, '__name__', str(v)))
+def test_a_bad_value_is_refused_as_the_executable_reports_it(
+        ros_domain, node_class, name, value):
+    with pytest.raises((ValueError, ParameterException)) as refused:
+        node = node_class(context=ros_domain[1],
+                          cli_args=['--ros-args', '-p', f'{name}:={value}'])
+        node.destroy_node()
+    assert name in str(refused.value)
 
 
 @pytest.mark.parametrize('node_class, name', [
