@@ -165,8 +165,8 @@ class PlannerNode(Node):
                             "the package's config/capability.yaml; 'none': no table, only "
                             "the model's limits", read_only=True)).value)
         self._ready_timeout = self._positive_parameter(
-            'ready_timeout', 1.0, 'inputs older than this (sim time) mean not ready; a climb '
-                                  'whose inputs stop for this long aborts [s]')
+            'ready_timeout', 1.0, 'inputs older than this (in sim and wall time) mean not '
+                                  'ready; a climb whose inputs stop for this long aborts [s]')
         self._swivel_joint = self.declare_parameter(
             'swivel_joint', 'swivel_joint',
             ParameterDescriptor(description='name of the swivel joint in joint_states',
@@ -177,6 +177,7 @@ class PlannerNode(Node):
         self._resets = 0  # sim/reset_events heard
         self._plans = _PlanWorker(self)
         self._received: dict[str, float] = {}  # topic -> sim time of its last message [s]
+        self._received_wall: dict[str, float] = {}  # topic -> steady clock then [s]
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
         self._last_tick = 0.0  # [s] node clock when the running climb last had a tick
         self._last_tick_wall = 0.0  # [s] steady clock then
@@ -300,6 +301,7 @@ class PlannerNode(Node):
         kept before.
         """
         self._received[topic] = self._now()
+        self._received_wall[topic] = time.monotonic()
         return self._climb is not None
 
     def _read(self, read: Callable[[bytes], tuple], data: bytes) -> tuple | None:
@@ -313,12 +315,25 @@ class PlannerNode(Node):
         for tick in self._sync.add(topic, stamp_to_seconds(stamp), value):
             self._on_tick(tick)
 
-    def _missing_inputs(self) -> list[str]:
-        """List the inputs not heard within ``ready_timeout`` of sim time (all, before /clock)."""
-        now = self._now()
+    def _missing_inputs(self, wall_too: bool = False) -> list[str]:
+        """
+        List the inputs not heard within ``ready_timeout`` of sim time (all, before /clock).
+
+        ``wall_too``: only those not heard within ``ready_timeout`` of wall time either (for a
+        request). Out of a climb the planner is outside the lockstep chain and the sim races
+        ahead of it: a planner not scheduled for a tenth of a second then takes the newest
+        /clock first (its subscription keeps only that one) and the inputs of the same moments
+        after it, from their queues, which look a second old in sim time though they came
+        milliseconds ago (seen on a loaded machine: the clock leapt 1.15 s ahead of them in
+        0.13 s of wall time, and a request then was refused on a running stack). An input that
+        has stopped is silent on both clocks.
+        """
+        now, wall = self._now(), time.monotonic()
+        timeout = self._ready_timeout
         return [topic for topic in _INPUTS
                 if now <= 0.0 or topic not in self._received
-                or now - self._received[topic] > self._ready_timeout]
+                or (now - self._received[topic] > timeout
+                    and (not wall_too or wall - self._received_wall[topic] > timeout))]
 
     # --- the climb ------------------------------------------------------------------------
 
@@ -330,7 +345,7 @@ class PlannerNode(Node):
             answer(self._failure(code, message))
             return
         if not request.plan_only:
-            missing = self._missing_inputs()
+            missing = self._missing_inputs(wall_too=True)
             if missing:
                 answer(self._failure(ErrorCode.NOT_READY,
                                      f'no recent message on {", ".join(missing)}: are the sim, '

@@ -217,6 +217,31 @@ def test_request_before_the_robot_is_up_is_not_ready(rig):
     assert rig.command is None
 
 
+def test_a_clock_ahead_of_the_queued_inputs_is_ready_a_silent_input_is_not(rig):
+    """
+    Check an input counts as gone only once silent for ready_timeout of sim and of wall time.
+
+    Out of a climb the sim races ahead of the planner: one not scheduled for a moment takes
+    the newest /clock before the inputs queued behind it, which then look old in sim time
+    though they came milliseconds ago. A stack whose odometry stopped is still refused.
+    """
+    rig.warm_up()
+    rig.car.cycles += 200  # [10 ms] the sim ran 2 s ahead, the inputs of it not yet taken
+    rig.publish_state(inputs=())  # the /clock alone
+    spin_until(rig.executor, lambda: rig.planner.get_clock().now().nanoseconds
+               >= rig.car.cycles * 10**7, 10.0, 'the planner to take the clock')
+    response = result_of(rig, rig.call(step_height=0.5, step_distance=1.0))
+    assert response.error_code == ErrorCode.UNREACHABLE_HEIGHT, response.message
+    # The odometry stops; the rest goes on for more than ready_timeout (1 s) of both clocks.
+    start = time.monotonic()
+    while time.monotonic() < start + 1.2:
+        rig.warm_up(cycles=1, inputs=('joint_states', 'imu', 'controller'))
+    response = result_of(rig, rig.call(step_height=0.5, step_distance=1.0))
+    assert response.error_code == ErrorCode.NOT_READY
+    assert response.message.startswith('no recent message on odom: '), response.message
+    assert rig.command is None
+
+
 def test_plan_only_returns_the_plan_without_moving(rig):
     response = result_of(rig, rig.call(**SUCCESSFUL_CLIMB, plan_only=True))
     assert response.success, response.message
