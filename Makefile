@@ -36,27 +36,21 @@ BUILD_INPUTS := $(shell find swivel_car_* -type f -not -path '*/__pycache__/*' \
     -o -path '*/msg/*' -o -path '*/srv/*' -o -path '*/action/*' -o -path '*/config/*' \
     -o -path '*/launch/*' -o -path '*/resource/*' \))
 
-# Three jobs side by side, since the interfaces' generators and compilers leave a core mostly
-# idle: the interfaces; the Python packages, which need them only at run time (colcon would
-# otherwise wait for them); and, after a set-up, byte-compiling the venv. With
-# PYTHONDONTWRITEBYTECODE set, as on our machines, every node process would otherwise compile
-# rclpy, numpy and pybullet again (4.3 s instead of 1.5 s to import them).
+# Two jobs side by side, since the interfaces' generators and compilers leave a core mostly
+# idle: the interfaces, and the Python packages, which need them only at run time (colcon would
+# otherwise wait for them).
 COLCON_BUILD_ARGS := --symlink-install --event-handlers console_cohesion- summary+
-BYTECODE := $(VENV)/.bytecode-compiled
 
 $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	@echo '== building ros2_ws'
 	@# A file removed from a package leaves a dangling symlink that fails the symlink install.
 	find ros2_ws/build ros2_ws/install -xtype l -delete 2>/dev/null || true
 	rm -f ros2_ws/install/.swivel_car_built_*
-	test $(BYTECODE) -nt $(STAMP) || { $(VENV)/bin/python -m compileall -qq -j 0 \
-	    $$($(VENV)/bin/python -c 'import sysconfig; print(sysconfig.get_path("purelib"))') \
-	    ; touch $(BYTECODE); } & compiling=$$!; \
 	cd ros2_ws && { ../$(IN_WS) colcon --log-base log/python_packages build $(COLCON_BUILD_ARGS) \
 	    --packages-ignore swivel_car_msgs & python_packages=$$!; }; \
 	../$(IN_WS) colcon build $(COLCON_BUILD_ARGS) --packages-select swivel_car_msgs \
 	    --cmake-args -DBUILD_TESTING=OFF -DSWIVEL_CAR_MSGS_CPP=$(MSGS_CPP); msgs=$$?; \
-	wait $$python_packages && wait $$compiling && exit $$msgs
+	wait $$python_packages && exit $$msgs
 	touch $@
 
 # Test files run side by side, one pytest-xdist worker per core (PYTEST_WORKERS=0: in one
