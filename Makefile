@@ -9,7 +9,7 @@ MSGS_CPP ?= OFF
 BUILT := ros2_ws/install/.swivel_car_built_msgs_cpp_$(MSGS_CPP)
 IN_WS := scripts/in_ws
 PYTEST_ARGS ?=
-PYTEST_WORKERS ?= $(shell echo $$(( $$(nproc) + 1 )))
+PYTEST_WORKERS ?= auto
 
 .PHONY: setup build test demo figures bench soak clean
 
@@ -53,12 +53,9 @@ $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	wait $$python_packages && exit $$msgs
 	touch $@
 
-# Test files run side by side, one pytest-xdist worker per core and one more (PYTEST_WORKERS=0:
-# in one process): a worker also waits, on node processes that start and discover each other,
-# and the third keeps the 2 cores busier (94 % against 87 %; in alternating runs the suite took
-# 0.53-0.54 s of wall per CPU second against 0.59). Each worker claims its own block of ROS
-# domain ids. A file stays on one worker (module fixtures carry a stack from test to test), in
-# the order pytest.ini lists them.
+# Test files run side by side, one pytest-xdist worker per core (PYTEST_WORKERS=0: in one
+# process); each worker claims its own block of ROS domain ids. A file stays on one worker
+# (module fixtures carry a stack from test to test), in the order pytest.ini lists them.
 test: build
 	@echo '== running every test'
 	$(IN_WS) python -m pytest -n $(PYTEST_WORKERS) --dist loadfile --no-loadscope-reorder \
