@@ -209,6 +209,11 @@ def grid_refusals(s: Search) -> int:
     return sum(h.refused for h in s.heights)
 
 
+def geometry_searches(found: dict[str, list[Search]]) -> list[Search]:
+    """Return the searches of every geometry sweep, in ``GEOMETRY``'s order."""
+    return [s for name in GEOMETRY for s in found[f'design_{name}']]
+
+
 def proposal(geometry: list[Search], layout: list[Search],
              default: CarDescription) -> dict[str, Any]:
     """
@@ -378,7 +383,7 @@ class Campaign:
         Nothing is planned if a geometry sweep measured it already.
         """
         self.planned = True
-        geometry = [s for name in GEOMETRY for s in found[f'design_{name}']]
+        geometry = geometry_searches(found)
         proposed = proposal(geometry, found[LAYOUT], self.default)
         if not proposed or any(changes(s.point.robot, self.default) == proposed
                                for s in geometry):
@@ -433,7 +438,7 @@ def write_page(docs: Path, campaign: Campaign, rows, fidelity_rows, ran: int, wa
     default = campaign.default
     figures = docs / 'figures'
     figures.mkdir(parents=True, exist_ok=True)
-    geometry = [s for name in GEOMETRY for s in found[f'design_{name}']]
+    geometry = geometry_searches(found)
     revisions = sorted({row['git_revision'] for row in rows.values()})
     climb_wall = sum(float(row['wall']) for row in rows.values())
     lines = [
@@ -509,8 +514,8 @@ def room_table(room: list[Search]) -> list[str]:
 
 def recommended(found: dict[str, list[Search]], default: CarDescription) -> Search:
     """Return the best of the geometry points and the confirmed proposal, by ``_rank``."""
-    candidates = [s for name in GEOMETRY for s in found[f'design_{name}']]
-    return max(candidates + found.get('confirm', []), key=lambda s: _rank(s, default))
+    return max(geometry_searches(found) + found.get('confirm', []),
+               key=lambda s: _rank(s, default))
 
 
 def recommendation_section(found, default: CarDescription, geometry: list[Search],
