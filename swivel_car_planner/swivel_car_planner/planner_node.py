@@ -176,8 +176,8 @@ class PlannerNode(Node):
         self._planning = False  # a climb's plan is being made (the climb slot is taken)
         self._resets = 0  # sim/reset_events heard
         self._plans = _PlanWorker(self)
-        self._received: dict[str, float] = {}  # topic -> sim time of its last message [s]
-        self._received_wall: dict[str, float] = {}  # topic -> steady clock then [s]
+        # topic -> (sim time [s], steady clock [s]) of its last message
+        self._received: dict[str, tuple[float, float]] = {}
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
         self._last_tick = 0.0  # [s] node clock when the running climb last had a tick
         self._last_tick_wall = 0.0  # [s] steady clock then
@@ -300,8 +300,7 @@ class PlannerNode(Node):
         A climb starts from the inputs heard after its planning (``_planned``), so none is
         kept before.
         """
-        self._received[topic] = self._now()
-        self._received_wall[topic] = time.monotonic()
+        self._received[topic] = (self._now(), time.monotonic())
         return self._climb is not None
 
     def _read(self, read: Callable[[bytes], tuple], data: bytes) -> tuple | None:
@@ -330,10 +329,13 @@ class PlannerNode(Node):
         """
         now, wall = self._now(), time.monotonic()
         timeout = self._ready_timeout
+
+        def silent(topic: str) -> bool:
+            sim, steady = self._received[topic]
+            return now - sim > timeout and (not wall_too or wall - steady > timeout)
+
         return [topic for topic in _INPUTS
-                if now <= 0.0 or topic not in self._received
-                or (now - self._received[topic] > timeout
-                    and (not wall_too or wall - self._received_wall[topic] > timeout))]
+                if now <= 0.0 or topic not in self._received or silent(topic)]
 
     # --- the climb ------------------------------------------------------------------------
 
