@@ -204,8 +204,8 @@ class PlannerNode(Node):
         # A dead sim stops /clock, and with it every sim-time timer: this one is not stopped.
         self.create_timer(self._ready_timeout / 4.0, self._check_sim_alive,
                           clock=Clock(clock_type=ClockType.STEADY_TIME))
-        # The model's swivel drift is integrated once per robot (a second); done now, the first
-        # climb's planning does not take that second longer.
+        # The model's swivel drift is integrated once per robot (0.3 s of CPU); done now, the
+        # first climb's planning does not take that much longer.
         dynamics.swivel_pose_drift(self.robot, 0.0, self.robot.max_swivel_angle)
         self.get_logger().info(
             f'planner ready: model max scalable step {self._max_step():.3f} m, torque limit '
