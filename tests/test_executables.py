@@ -11,7 +11,7 @@ import itertools
 import os
 
 import pytest
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from swivel_car_testing import executable_path, NodeProcess, REPO_ROOT, spin_until
 
@@ -53,7 +53,7 @@ def test_executable_installed_and_starts(ros_domain, package, executable):
     process = NodeProcess(package, executable, domain_id,
                           extra_args=('--ros-args', '-r', f'__ns:={namespace}'))
     probe = Node('executable_probe', context=context)
-    executor = SingleThreadedExecutor(context=context)
+    executor = EventsExecutor(context=context)
     executor.add_node(probe)
     try:
         node = (executable.removesuffix('_node'), namespace)

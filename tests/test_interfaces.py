@@ -11,7 +11,7 @@ import math
 
 import pytest
 from rclpy.action import ActionClient, ActionServer
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from swivel_car_msgs import action, msg, srv
 from swivel_car_testing import spin_until
@@ -40,7 +40,7 @@ def _filled(message):
 def node_and_executor(ros_domain):
     _, context = ros_domain
     node = Node('interface_test', context=context)
-    executor = SingleThreadedExecutor(context=context)
+    executor = EventsExecutor(context=context)
     executor.add_node(node)
     yield node, executor
     executor.shutdown()

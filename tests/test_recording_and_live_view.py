@@ -25,7 +25,7 @@ from mcap.reader import make_reader
 from mcap_ros2._dynamic import generate_dynamic
 from mcap_ros2.decoder import DecoderFactory
 import pytest
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
@@ -88,7 +88,7 @@ def test_a_recorded_run_reads_back_with_an_independent_reader(ros_domain, tmp_pa
     recorder = _start(domain_id, ('swivel_car_bringup', 'recorder_node',
                                   {'output': str(bag), 'discovery_period': 0.2}))[0]
     probe = Probe(context)
-    executor = SingleThreadedExecutor(context=context)
+    executor = EventsExecutor(context=context)
     executor.add_node(probe)
     step = probe.create_client(StepSimulation, 'sim/step')
     topics = ['/clock', '/joint_states', '/imu', '/ground_truth/odom', '/odom',
@@ -166,7 +166,7 @@ def test_robot_description_for_a_late_subscriber_matches_joint_states(ros_domain
     stack = _start(domain_id, ('swivel_car_sim', 'sim_node', {}),
                    ('swivel_car_bringup', 'robot_description_node', {}))
     probe = Probe(context)
-    executor = SingleThreadedExecutor(context=context)
+    executor = EventsExecutor(context=context)
     executor.add_node(probe)
     try:
         spin_until(executor, lambda: len(probe.joint_states) > 10, 60.0, 'joint_states')

@@ -33,7 +33,7 @@ from nav_msgs.msg import Odometry
 import pytest
 from rcl_interfaces.srv import SetParameters
 import rclpy
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.task import Future
@@ -80,7 +80,7 @@ class Stack:
         self.processes = {name: self.start(name) for name in NODES}
         self.user = Node('user', context=context,
                          parameter_overrides=[Parameter('use_sim_time', value=True)])
-        self.executor = SingleThreadedExecutor(context=context)
+        self.executor = EventsExecutor(context=context)
         self.executor.add_node(self.user)
         self.truth: list[Odometry] = []
         self.odom: list[Odometry] = []

@@ -12,7 +12,7 @@ from builtin_interfaces.msg import Time
 from geometry_msgs.msg import TwistStamped
 import pytest
 import rclpy
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -39,7 +39,7 @@ class Rig:
                    domain_id=next_domain_id())
         self.node = ControllerNode()
         self.probe = rclpy.create_node('probe')
-        self.executor = SingleThreadedExecutor()
+        self.executor = EventsExecutor()
         self.executor.add_node(self.node)
         self.executor.add_node(self.probe)
         self.commands = []

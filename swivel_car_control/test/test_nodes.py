@@ -12,7 +12,7 @@ from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 import pytest
 import rclpy
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
@@ -36,7 +36,7 @@ class Harness:
         rclpy.init(args=args, domain_id=next_domain_id())
         self.node = node_class()
         self.probe = rclpy.create_node('probe')
-        self.executor = SingleThreadedExecutor()
+        self.executor = EventsExecutor()
         self.executor.add_node(self.node)
         self.executor.add_node(self.probe)
         self.received = {}

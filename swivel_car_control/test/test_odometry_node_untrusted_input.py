@@ -12,7 +12,7 @@ from nav_msgs.msg import Odometry
 import pytest
 from rcl_interfaces.msg import Log
 import rclpy
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from sensor_msgs.msg import JointState
 from swivel_car_control.odometry_node import OdometryNode
 from swivel_car_model.description import CarDescription
@@ -37,7 +37,7 @@ def odometry():
     rclpy.init(args=['--ros-args', '-p', 'enable_odom_tf:=false'], domain_id=next_domain_id())
     node = OdometryNode()
     probe = rclpy.create_node('probe')
-    executor = SingleThreadedExecutor()
+    executor = EventsExecutor()
     executor.add_node(node)
     executor.add_node(probe)
     try:

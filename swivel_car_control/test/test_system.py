@@ -13,7 +13,7 @@ from nav_msgs.msg import Odometry
 import pytest
 import rclpy
 from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from swivel_car_testing import config_path, next_domain_id, NodeProcess, spin_until
 
 DEADMAN = 2.0  # [s] sim time
@@ -53,7 +53,7 @@ class Driver:
 
     def __init__(self, context):
         self.node = rclpy.create_node('system_test_driver', context=context)
-        self.executor = SingleThreadedExecutor(context=context)
+        self.executor = EventsExecutor(context=context)
         self.executor.add_node(self.node)
         self.truth: list[Odometry] = []
         self.odom: list[Odometry] = []

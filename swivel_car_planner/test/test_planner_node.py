@@ -20,7 +20,6 @@ from nav_msgs.msg import Odometry
 import pytest
 import rclpy
 from rclpy.action import ActionClient
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
@@ -63,7 +62,7 @@ class Rig:
         self.thread = threading.Thread(target=self._spin_planner, daemon=True)
         self.thread.start()
         self.node = rclpy.create_node('robot', context=self.context)
-        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor = EventsExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.car = KinematicCar()
         # The step the tests' climbs name, so the car pitches with its front axle on top.

@@ -8,7 +8,7 @@ from builtin_interfaces.msg import Time
 from nav_msgs.msg import Odometry
 import pytest
 import rclpy
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
@@ -45,7 +45,7 @@ class Harness:
         self.sim = SimNode(context=self.context, namespace=namespace, parameter_overrides=[
             Parameter(name, value=value) for name, value in parameters.items()])
         self.client = Node('test_client', namespace=namespace, context=self.context)
-        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor = EventsExecutor(context=self.context)
         self.executor.add_node(self.sim)
         self.executor.add_node(self.client)
         self.joint_states, self.clock, self.imu, self.odom = [], [], [], []

@@ -3,7 +3,7 @@
 import os
 
 import rclpy
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -25,7 +25,7 @@ def test_installed_sim_node_runs_lockstep_with_a_controller_and_exits_cleanly():
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain)
     node = Node('fake_controller', namespace=namespace, context=context)
-    executor = SingleThreadedExecutor(context=context)
+    executor = EventsExecutor(context=context)
     executor.add_node(node)
     try:
         commands = node.create_publisher(ActuatorCommand, 'actuator_command', 10)

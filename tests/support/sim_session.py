@@ -19,7 +19,7 @@ from typing import Any, Callable
 from nav_msgs.msg import Odometry
 import rclpy
 from rclpy.action import ActionClient
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from std_srvs.srv import Empty, SetBool
 from swivel_car_model.description import CarDescription
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
@@ -101,7 +101,7 @@ class SimSession:
             self.context = rclpy.Context()
             rclpy.init(context=self.context, domain_id=self.domain_id)
             self.node = rclpy.create_node('climb_client', context=self.context)
-            self.executor = SingleThreadedExecutor(context=self.context)
+            self.executor = EventsExecutor(context=self.context)
             self.executor.add_node(self.node)
         except BaseException:
             self._stop_processes()
