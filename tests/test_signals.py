@@ -14,28 +14,34 @@ import pytest
 from swivel_car_testing import next_domain_id, NodeProcess
 
 SIM_TIME = {'use_sim_time': True}
+PLANNER = ('swivel_car_planner', 'planner_node', SIM_TIME)
+# Started once the planner is ready (it starts slowest): an unpaced stack would run for
+# nothing meanwhile.
 NODES = [('swivel_car_control', 'controller_node', SIM_TIME),
          ('swivel_car_control', 'odometry_node', SIM_TIME),
-         ('swivel_car_planner', 'planner_node', SIM_TIME),
          # Lockstep as fast as the controller answers: every node is in a callback most of
          # the time, where the signal must land to show the fault.
          ('swivel_car_sim', 'sim_node', {'lockstep': True, 'lockstep_timeout': 1.0})]
+
+
+def wait_for_output(process: NodeProcess, text: str, deadline: float) -> None:
+    while text not in process.output():
+        assert process.running() and time.monotonic() < deadline, process.output()
+        time.sleep(0.05)
 
 
 @pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM],
                          ids=lambda s: signal.Signals(s).name)
 def test_a_signal_ends_every_busy_node_with_exit_0_and_no_traceback(signum):
     domain_id = next_domain_id()
-    processes = [NodeProcess(package, executable, domain_id, parameters)
-                 for package, executable, parameters in NODES]
+    processes = [NodeProcess(*PLANNER[:2], domain_id, PLANNER[2])]
     try:
         deadline = time.monotonic() + 60.0
-        controller = processes[0]
+        wait_for_output(processes[0], 'planner ready', deadline)
+        processes += [NodeProcess(package, executable, domain_id, parameters)
+                      for package, executable, parameters in NODES]
         # Up and answering: the controller has logged its start and the sim runs.
-        while 'controller up' not in controller.output() or 'planner ready' not in \
-                processes[2].output():
-            assert time.monotonic() < deadline, [p.output() for p in processes]
-            time.sleep(0.2)
+        wait_for_output(processes[1], 'controller up', deadline)
         time.sleep(0.5)  # some 500 lockstep periods: every node busy
         for process in processes:
             process.process.send_signal(signum)
