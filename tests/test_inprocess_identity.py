@@ -182,7 +182,7 @@ def _spin_for(session: SimSession, seconds: float) -> None:
 
 @pytest.fixture
 def ros_run():
-    session = SimSession(sim_parameters={'start_paused': True})
+    session = SimSession()  # paused at sim time 0 until _ros_climb resumes it
     try:
         recorder = _Recorder(session)
         result, first_tick = _ros_climb(session, recorder, ClimbStep.Request(

@@ -77,7 +77,9 @@ class Stack:
 
     def __init__(self, domain_id: int, context) -> None:
         self.domain_id = domain_id
-        self.processes = {name: self.start(name) for name in NODES}
+        # The sim paused until this node has discovered it (shared_stack): unpaced, it would
+        # otherwise run tens of seconds of sim time for nothing meanwhile.
+        self.processes = {name: self.start(name, paused=True) for name in NODES}
         self.user = Node('user', context=context,
                          parameter_overrides=[Parameter('use_sim_time', value=True)])
         self.executor = EventsExecutor(context=context)
@@ -114,13 +116,18 @@ class Stack:
         self.climb = self.user.create_client(ClimbStep, 'climb_step')
         self.climbs: list[Future] = []
 
-    def start(self, name: str) -> NodeProcess:
-        """Start node ``name``, over UDP: shared memory does not survive a kill -9."""
+    def start(self, name: str, paused: bool = False) -> NodeProcess:
+        """
+        Start node ``name``, over UDP: shared memory does not survive a kill -9.
+
+        ``paused``: a sim starts paused.
+        """
         package, executable = NODES[name]
         # Over shared memory, about 1 run in 8 a node started again after a kill -9, or one
         # the killed node had been sending to, was never heard again.
         return start_node(package, executable, self.domain_id, {
-            'use_sim_time': True, **lockstep_parameters(
+            'use_sim_time': True, **({'start_paused': True} if paused and name == 'sim' else {}),
+            **lockstep_parameters(
                 executable, LOCKSTEP_TIMEOUT, real_time_factor=0.0, cmd_vel_driver=True)},
             loopback_udp=True)
 
@@ -394,6 +401,7 @@ def shared_stack() -> Iterator[Stack]:
     rclpy.init(context=context, domain_id=domain_id)
     running = Stack(domain_id, context)
     try:
+        running.call(running.set_paused, SetBool.Request(data=False), 'sim/set_paused')
         yield running
     finally:
         running.close()

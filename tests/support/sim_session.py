@@ -56,7 +56,8 @@ class SimSession:
     planner : bool
         Start planner_node (the car-like baseline is driven with cmd_vel only).
     sim_parameters : mapping
-        ``-p`` overrides for sim_node, on top of the lockstep ones (e.g. ``start_paused``).
+        ``-p`` overrides for sim_node, on top of the lockstep ones. The sim starts paused
+        (``start_paused``); `wait_ready` resumes it.
 
     """
 
@@ -82,7 +83,10 @@ class SimSession:
         sim_time = {'use_sim_time': True, **joint}
         # In the lockstep chain the planner's climbs do not depend on the machine's load, and
         # nothing outside it drives the car: the sim runs as fast as the chain answers.
-        specs = [('swivel_car_sim', 'sim_node', {'robot_variant': robot_variant, **robot}),
+        # Paused until this node has discovered the stack (some 2.3 s after the sim is up): an
+        # unpaced sim otherwise ran 20-45 s of sim time for nothing meanwhile.
+        sim = {'robot_variant': robot_variant, 'start_paused': True, **robot}
+        specs = [('swivel_car_sim', 'sim_node', sim),
                  ('swivel_car_control', 'controller_node', {**sim_time, **robot}),
                  ('swivel_car_control', 'odometry_node', {**sim_time, **robot})]
         if planner:
@@ -148,11 +152,18 @@ class SimSession:
             f'\n{p.output()[-REPORT_CHARS:]}' for p in self.processes)
 
     def wait_ready(self, timeout: float = 60.0) -> None:
-        """Until the sim, the controller and the odometry publish and the services are up."""
+        """
+        Wait until the stack's services are up, resume the sim, wait until it runs.
+
+        Running: the sim, the controller and the odometry publish, and the planner hears them.
+        """
         clients = [self.spawn_client, self.reset_client, self.pause_client,
                    self.odometry_reset]
         if self._planner:
             clients.append(self.climb_client)
+        self.spin_until(lambda: all(c.service_is_ready() for c in clients), timeout,
+                        'the services of the stack')
+        self.set_paused(False)
         self.spin_until(lambda: (self.truth is not None and self.odom_count > 0
                                  and self.controller_state is not None
                                  and all(c.service_is_ready() for c in clients)),
