@@ -117,6 +117,19 @@ class NodeProcess:
     def running(self) -> bool:
         return self.process.poll() is None
 
+    def wait_for_output(self, text: str, timeout: float) -> None:
+        """
+        Wait until the process has printed ``text`` (a log line that says it is up).
+
+        AssertionError with its output if it ends first or after ``timeout`` wall seconds (a
+        guard against a hang, not a measurement).
+        """
+        deadline = time.monotonic() + timeout
+        while text not in self.output():
+            assert self.running() and time.monotonic() < deadline, \
+                f'{self.name} did not print {text!r}:\n{self.output()[-3000:]}'
+            time.sleep(0.05)
+
     def stop(self, timeout: float = 10.0) -> int:
         """SIGINT, then SIGKILL after ``timeout`` seconds; returns the exit code."""
         if self.process.poll() is None:

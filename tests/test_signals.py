@@ -24,24 +24,17 @@ NODES = [('swivel_car_control', 'controller_node', SIM_TIME),
          ('swivel_car_sim', 'sim_node', {'lockstep': True, 'lockstep_timeout': 1.0})]
 
 
-def wait_for_output(process: NodeProcess, text: str, deadline: float) -> None:
-    while text not in process.output():
-        assert process.running() and time.monotonic() < deadline, process.output()
-        time.sleep(0.05)
-
-
 @pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM],
                          ids=lambda s: signal.Signals(s).name)
 def test_a_signal_ends_every_busy_node_with_exit_0_and_no_traceback(signum):
     domain_id = next_domain_id()
     processes = [NodeProcess(*PLANNER[:2], domain_id, PLANNER[2])]
     try:
-        deadline = time.monotonic() + 60.0
-        wait_for_output(processes[0], 'planner ready', deadline)
+        processes[0].wait_for_output('planner ready', 60.0)
         processes += [NodeProcess(package, executable, domain_id, parameters)
                       for package, executable, parameters in NODES]
         # Up and answering: the controller has logged its start and the sim runs.
-        wait_for_output(processes[1], 'controller up', deadline)
+        processes[1].wait_for_output('controller up', 60.0)
         time.sleep(0.5)  # some 500 lockstep periods: every node busy
         for process in processes:
             process.process.send_signal(signum)

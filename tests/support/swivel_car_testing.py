@@ -21,8 +21,8 @@ from swivel_car_stack import (
     ros_environment, spin_until, start_node)
 
 __all__ = ['config_path', 'executable_path', 'INSTALL_DIR', 'lockstep_parameters',
-           'next_domain_id', 'NodeProcess', 'REPO_ROOT', 'ros_environment', 'spin_until',
-           'start_node']
+           'next_domain_id', 'NodeProcess', 'remove_unborn_shm_ports', 'REPO_ROOT',
+           'ros_environment', 'spin_until', 'start_node']
 
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
 # stragglers are never heard. Every process (a pytest-xdist worker, another pytest, the
@@ -35,7 +35,44 @@ _held: list[IO[str]] = []
 _domain_ids: itertools.cycle | None = None
 
 
+def remove_unborn_shm_ports(shm_dir: Path = Path('/dev/shm')) -> list[str]:
+    """
+    Delete Fast DDS shared-memory ports that were never initialized and that no process holds.
+
+    A process killed while it created its port leaves the port's file all zeros, without a
+    lock file (so `fastdds shm clean` keeps it). A participant that later gets the same port
+    (the same domain and participant index) waits for its initialization forever, inside
+    rclpy's Node(): seen here, a planner blocked for 15 minutes in
+    SharedMemGlobal::open_port_internal, on a port file left six hours earlier. Returns the
+    names of the files deleted.
+    """
+    held: set[str] = set()
+    for process in Path('/proc').iterdir():
+        if not process.name.isdigit():
+            continue
+        try:
+            held.update(os.readlink(fd) for fd in (process / 'fd').iterdir())
+            held.update(line.split(maxsplit=5)[-1] for line in
+                        (process / 'maps').read_text().splitlines() if '/' in line)
+        except OSError:
+            continue  # ended meanwhile, or not ours to read
+    removed = []
+    for port in shm_dir.glob('fastrtps_port*'):
+        if port.name.endswith(('_el', '_sl')) or str(port) in held:
+            continue
+        try:
+            unborn = not any(port.read_bytes())
+        except OSError:
+            continue
+        if unborn:
+            for name in (port.name, f'sem.{port.name}_mutex'):
+                (shm_dir / name).unlink(missing_ok=True)
+            removed.append(port.name)
+    return removed
+
+
 def _claim_block() -> int:
+    remove_unborn_shm_ports()
     _LOCK_DIR.mkdir(exist_ok=True)
     for k in range(_BLOCKS):
         block = (os.getpid() + k) % _BLOCKS
