@@ -401,7 +401,10 @@ def shared_stack() -> Iterator[Stack]:
     rclpy.init(context=context, domain_id=domain_id)
     running = Stack(domain_id, context)
     try:
-        running.call(running.set_paused, SetBool.Request(data=False), 'sim/set_paused')
+        # Not waiting for the answer: a server that has not yet discovered this node's
+        # response reader drops it. The stack running (heal) shows the sim resumed.
+        running.spin_until(running.set_paused.service_is_ready, 60.0, 'sim/set_paused')
+        running.set_paused.call_async(SetBool.Request(data=False))
         yield running
     finally:
         running.close()

@@ -28,7 +28,7 @@ import pytest
 import rclpy
 from rclpy.context import Context
 from rclpy.experimental import EventsExecutor
-from std_srvs.srv import Empty
+from std_srvs.srv import Empty, SetBool
 from swivel_car_control.benchmark import routes, Segment
 from swivel_car_control.test.test_system import _seconds, _yaw
 from swivel_car_model.description import CarDescription
@@ -184,13 +184,21 @@ def driver():
     context = Context()
     rclpy.init(context=context, domain_id=domain_id)
     chain = {'real_time_factor': 0.0, 'cmd_vel_driver': True}
+    # The sim paused until this node has discovered it: unpaced, it would otherwise run tens
+    # of seconds of sim time for nothing meanwhile.
     processes = [start_node(package, executable, domain_id, {
-        'use_sim_time': True, **lockstep_parameters(executable, 6.0, **chain)})
-        for package, executable in (('swivel_car_sim', 'sim_node'),
-                                    ('swivel_car_control', 'controller_node'),
-                                    ('swivel_car_control', 'odometry_node'))]
+        'use_sim_time': True, **lockstep_parameters(executable, 6.0, **chain), **paused})
+        for package, executable, paused in (
+            ('swivel_car_sim', 'sim_node', {'start_paused': True}),
+            ('swivel_car_control', 'controller_node', {}),
+            ('swivel_car_control', 'odometry_node', {}))]
     route_driver = RouteDriver(context)
     try:
+        resume = route_driver.node.create_client(SetBool, 'sim/set_paused')
+        spin_until(route_driver.executor, resume.service_is_ready, 60.0, 'sim/set_paused')
+        # Not waiting for the answer: a server that has not yet discovered this node's
+        # response reader drops it. The stack running shows the sim resumed.
+        resume.call_async(SetBool.Request(data=False))
         spin_until(route_driver.executor, lambda: route_driver.time > 0.0 and route_driver.odom,
                    60.0, 'the stack')
         yield route_driver
