@@ -76,28 +76,10 @@ def _profile_at(p: SwivelCarParams, theta2: float, rate: float, side: float):
     return value, d1 * rate, d2 * rate * rate
 
 
-def _rot(yaw: float) -> np.ndarray:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([[c, -s], [s, c]])
-
-
-def _perp(v: np.ndarray) -> np.ndarray:
-    """Rotate vectors (..., 2) by +90 deg."""
-    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
-
-
 @dataclass(frozen=True)
 class _PlanarModel:
-    masses: np.ndarray  # [kg] (5,) body, rear right, rear left, front right, front left wheel
+    masses: tuple[float, ...]  # [kg] body, rear right, rear left, front right, front left wheel
     yaw_inertia: float  # [kg m^2] of the body about its own mass point
-
-    @functools.cached_property
-    def mass_list(self) -> list[float]:
-        return self.masses.tolist()  # [kg]
-
-    @functools.cached_property
-    def total_mass(self) -> float:
-        return float(np.sum(self.masses))  # [kg]
 
     @staticmethod
     def of(p: SwivelCarParams, yaw_inertia: float | None) -> '_PlanarModel':
@@ -105,35 +87,33 @@ class _PlanarModel:
         if yaw_inertia is None:
             # uniform plate of the car's footprint (the thesis gives no I_car)
             yaw_inertia = body * (p.wheelbase ** 2 + (2.0 * p.h) ** 2) / 12.0
-        return _PlanarModel(np.array([body] + [p.wheel_mass] * 4), float(yaw_inertia))
+        return _PlanarModel((float(body),) + (float(p.wheel_mass),) * 4, float(yaw_inertia))
 
 
-def _points(p: SwivelCarParams, value, d1, d2):
-    """Body-frame mass points (5, 2) and their time derivatives."""
-    rear = np.array([[0.0, -p.h], [0.0, p.h]])
-    pts = np.vstack([value[3:5], rear, value[5:7], value[7:9]])
-    dpts = np.vstack([d1[3:5], np.zeros((2, 2)), d1[5:7], d1[7:9]])
-    ddpts = np.vstack([d2[3:5], np.zeros((2, 2)), d2[5:7], d2[7:9]])
-    return pts, dpts, ddpts
+def _points(p: SwivelCarParams, value: list[float], d1: list[float],
+            d2: list[float]) -> tuple[tuple[float, ...], ...]:
+    """
+    Body-frame mass points, in ``_PlanarModel.masses``' order, and their time derivatives.
+
+    Each ``(x, y, dx/dt, dy/dt, d2x/dt2, d2y/dt2)`` [m, m/s, m/s^2]. In scalars: the DAE's
+    right-hand side reads them, where numpy's per-call cost on 2-vectors made it three times
+    slower.
+    """
+    rest = (0.0, 0.0, 0.0, 0.0)
+    return ((value[3], value[4], d1[3], d1[4], d2[3], d2[4]),
+            (0.0, -p.h) + rest, (0.0, p.h) + rest,
+            (value[5], value[6], d1[5], d1[6], d2[5], d2[6]),
+            (value[7], value[8], d1[7], d1[8], d2[7], d2[8]))
 
 
 def _planar_system(p, model, q, qd, value, d1, d2):
-    """
-    Mass matrix, bias forces, constraint matrix and its velocity/acceleration terms.
-
-    In scalars: this runs once per right-hand side of the DAE, and numpy's per-call cost on
-    2-vectors made it three times slower.
-    """
+    """Mass matrix, bias forces, constraint matrix and its velocity/acceleration terms."""
     yaw, vx, vy, wz = float(q[2]), float(qd[0]), float(qd[1]), float(qd[2])
     c, s = math.cos(yaw), math.sin(yaw)
     v, v1, v2 = value.tolist(), d1.tolist(), d2.tolist()
-    # the mass points in the body frame, as in _points, and their time derivatives
-    points = ((v[3], v[4], v1[3], v1[4], v2[3], v2[4]),
-              (0.0, -p.h, 0.0, 0.0, 0.0, 0.0), (0.0, p.h, 0.0, 0.0, 0.0, 0.0),
-              (v[5], v[6], v1[5], v1[6], v2[5], v2[6]), (v[7], v[8], v1[7], v1[8], v2[7], v2[8]))
     first_x = first_y = inertia = force_x = force_y = torque = 0.0
     wz2 = wz * wz
-    for m, (px, py, dpx, dpy, ddpx, ddpy) in zip(model.mass_list, points):
+    for m, (px, py, dpx, dpy, ddpx, ddpy) in zip(model.masses, _points(p, v, v1, v2)):
         rx, ry = c * px - s * py, s * px + c * py
         rdx, rdy = c * dpx - s * dpy, s * dpx + c * dpy
         rddx, rddy = c * ddpx - s * ddpy, s * ddpx + c * ddpy
@@ -145,7 +125,7 @@ def _planar_system(p, model, q, qd, value, d1, d2):
         force_x += m * extra_x
         force_y += m * extra_y
         torque += m * (rx * extra_y - ry * extra_x)
-    total = model.total_mass
+    total = sum(model.masses)
     mass_matrix = np.array([[total, 0.0, first_x], [0.0, total, first_y],
                             [first_x, first_y, inertia + model.yaw_inertia]])
     bias = np.array([force_x, force_y, torque])
@@ -193,11 +173,16 @@ class PlanarResult:
 
 
 def _kinetic_energy(p, model, q, qd, value, d1):
-    rot = _rot(q[2])
-    pts, dpts, _ = _points(p, value, d1, d1 * 0.0)
-    vel = qd[:2] + qd[2] * _perp(pts @ rot.T) + dpts @ rot.T
-    return 0.5 * float(np.sum(model.masses * np.sum(vel * vel, axis=1))) \
-        + 0.5 * model.yaw_inertia * qd[2] ** 2
+    yaw, vx, vy, wz = float(q[2]), float(qd[0]), float(qd[1]), float(qd[2])
+    c, s = math.cos(yaw), math.sin(yaw)
+    v, v1 = value.tolist(), d1.tolist()
+    energy = 0.5 * model.yaw_inertia * wz * wz
+    for m, (px, py, dpx, dpy, _, _) in zip(model.masses, _points(p, v, v1, v1)):
+        # qd_xy + wz J R p + R dp/dt
+        vel_x = vx - wz * (s * px + c * py) + c * dpx - s * dpy
+        vel_y = vy + wz * (c * px - s * py) + s * dpx + c * dpy
+        energy += 0.5 * m * (vel_x * vel_x + vel_y * vel_y)
+    return energy
 
 
 def _simulate_planar(p: SwivelCarParams, theta2_start: float, rate: float, duration: float,
