@@ -47,7 +47,7 @@ from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerSta
 from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
 from swivel_car_ros.ros_params import moment_seconds, stamp_to_seconds
 from swivel_car_testing import (
-    lockstep_parameters, next_domain_id, NodeProcess, spin_until, start_node)
+    lockstep_parameters, next_domain_id, NodeProcess, resume_sim, spin_until, start_node)
 
 NODES = {'sim': ('swivel_car_sim', 'sim_node'),
          'controller': ('swivel_car_control', 'controller_node'),
@@ -77,8 +77,7 @@ class Stack:
 
     def __init__(self, domain_id: int, context) -> None:
         self.domain_id = domain_id
-        # The sim paused until this node has discovered it (shared_stack): unpaced, it would
-        # otherwise run tens of seconds of sim time for nothing meanwhile.
+        # The sim paused until this node has discovered it (resume_sim, in shared_stack).
         self.processes = {name: self.start(name, paused=True) for name in NODES}
         self.user = Node('user', context=context,
                          parameter_overrides=[Parameter('use_sim_time', value=True)])
@@ -401,10 +400,7 @@ def shared_stack() -> Iterator[Stack]:
     rclpy.init(context=context, domain_id=domain_id)
     running = Stack(domain_id, context)
     try:
-        # Not waiting for the answer: a server that has not yet discovered this node's
-        # response reader drops it. The stack running (heal) shows the sim resumed.
-        running.spin_until(running.set_paused.service_is_ready, 60.0, 'sim/set_paused')
-        running.set_paused.call_async(SetBool.Request(data=False))
+        resume_sim(running.executor, running.set_paused)
         yield running
     finally:
         running.close()

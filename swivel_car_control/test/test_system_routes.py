@@ -36,7 +36,7 @@ from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ResetSimulation
 from swivel_car_ros.lockstep import ChainEntry, Entry, stamp_ns
 from swivel_car_testing import (
-    lockstep_parameters, next_domain_id, spin_until, start_node)
+    lockstep_parameters, next_domain_id, resume_sim, spin_until, start_node)
 
 SETTLE = 1.0  # [s] sim time standing still at the end of a route, as the benchmark
 # Our odometry's end-pose error, % of the distance travelled; the in-process benchmark
@@ -184,8 +184,7 @@ def driver():
     context = Context()
     rclpy.init(context=context, domain_id=domain_id)
     chain = {'real_time_factor': 0.0, 'cmd_vel_driver': True}
-    # The sim paused until this node has discovered it: unpaced, it would otherwise run tens
-    # of seconds of sim time for nothing meanwhile.
+    # The sim paused until this node has discovered it (resume_sim).
     processes = [start_node(package, executable, domain_id, {
         'use_sim_time': True, **lockstep_parameters(executable, 6.0, **chain), **paused})
         for package, executable, paused in (
@@ -194,11 +193,8 @@ def driver():
             ('swivel_car_control', 'odometry_node', {}))]
     route_driver = RouteDriver(context)
     try:
-        resume = route_driver.node.create_client(SetBool, 'sim/set_paused')
-        spin_until(route_driver.executor, resume.service_is_ready, 60.0, 'sim/set_paused')
-        # Not waiting for the answer: a server that has not yet discovered this node's
-        # response reader drops it. The stack running shows the sim resumed.
-        resume.call_async(SetBool.Request(data=False))
+        resume_sim(route_driver.executor,
+                   route_driver.node.create_client(SetBool, 'sim/set_paused'))
         spin_until(route_driver.executor, lambda: route_driver.time > 0.0 and route_driver.odom,
                    60.0, 'the stack')
         yield route_driver

@@ -165,8 +165,7 @@ class SimSession:
                         'the services of the stack')
         self.set_paused(False)
         self.spin_until(lambda: (self.truth is not None and self.odom_count > 0
-                                 and self.controller_state is not None
-                                 and all(c.service_is_ready() for c in clients)),
+                                 and self.controller_state is not None),
                         timeout, 'the stack (sim, controller, odometry, planner)')
         if self._planner:
             self.spin_until(self.climb_action.server_is_ready, timeout, 'the climb action')

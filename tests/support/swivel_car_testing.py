@@ -14,15 +14,16 @@ import itertools
 import os
 from pathlib import Path
 import tempfile
-from typing import IO
+from typing import Any, IO
 
+from std_srvs.srv import SetBool
 from swivel_car_stack import (
     config_path, executable_path, INSTALL_DIR, lockstep_parameters, NodeProcess, REPO_ROOT,
     ros_environment, spin_until, start_node)
 
 __all__ = ['config_path', 'executable_path', 'INSTALL_DIR', 'lockstep_parameters',
            'next_domain_id', 'NodeProcess', 'remove_unborn_shm_ports', 'REPO_ROOT',
-           'ros_environment', 'spin_until', 'start_node']
+           'resume_sim', 'ros_environment', 'spin_until', 'start_node']
 
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
 # stragglers are never heard. Every process (a pytest-xdist worker, another pytest, the
@@ -69,6 +70,19 @@ def remove_unborn_shm_ports(shm_dir: Path = Path('/dev/shm')) -> list[str]:
                 (shm_dir / name).unlink(missing_ok=True)
             removed.append(port.name)
     return removed
+
+
+def resume_sim(executor: Any, set_paused: Any, timeout: float = 60.0) -> None:
+    """
+    Resume a sim started paused once the ``set_paused`` client (its ~/set_paused) has found it.
+
+    A stack's sim starts paused so that it does not run tens of seconds of sim time for nothing
+    while the test's node discovers it (some 2.3 s). Not waiting for the answer: a server that
+    has not yet discovered the caller's response reader drops it; the stack running shows the
+    sim resumed.
+    """
+    spin_until(executor, set_paused.service_is_ready, timeout, set_paused.srv_name)
+    set_paused.call_async(SetBool.Request(data=False))
 
 
 def _claim_block() -> int:
