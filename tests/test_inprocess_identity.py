@@ -37,8 +37,8 @@ from std_srvs.srv import Empty
 from swivel_car_bringup.inprocess import InProcessStack, StackConfig
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand
 from swivel_car_msgs.srv import ClimbStep, StepSimulation
-from swivel_car_planner.conversions import read_header
 from swivel_car_planner.core import ClimbRequest, ErrorCode
+from swivel_car_ros.serialized import read_header
 from swivel_car_sim.config import SimNodeConfig
 
 HEIGHT = 0.04  # [m]

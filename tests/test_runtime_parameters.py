@@ -8,8 +8,10 @@ A parameter either applies live or is read-only, and a bad value is refused with
 
 import math
 
+from nav_msgs.msg import Odometry
 import pytest
 from rclpy.parameter import Parameter
+from rclpy.serialization import deserialize_message
 
 from swivel_car_control.controller_node import ControllerNode
 from swivel_car_control.odometry_node import OdometryNode
@@ -82,13 +84,15 @@ def test_a_bad_live_controller_value_is_refused_with_the_reason(make_node, name,
 def test_the_odometry_covariances_apply_live_and_bad_ones_are_refused(make_node):
     node = make_node(OdometryNode)
     assert set_one(node, 'pose_covariance_diagonal', [0.5] * 6).successful
-    assert node._odom.pose.covariance[0] == 0.5
+    published = deserialize_message(node._odom.serialized(), Odometry)
+    assert published.pose.covariance[0] == 0.5
     result = set_one(node, 'twist_covariance_diagonal', [0.1, math.nan, 0.0, 0.0, 0.0, 0.0])
     assert not result.successful and 'twist_covariance_diagonal must be 6 finite numbers' \
         in result.reason
     result = set_one(node, 'twist_covariance_diagonal', 0.1)
     assert not result.successful and 'lists of 6 numbers' in result.reason
-    assert node._odom.twist.covariance[0] == 0.001
+    published = deserialize_message(node._odom.serialized(), Odometry)
+    assert published.twist.covariance[0] == 0.001
 
 
 def test_the_planners_climb_settings_apply_from_the_next_climb(make_node):

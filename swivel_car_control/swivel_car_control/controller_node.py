@@ -26,6 +26,8 @@ from swivel_car_ros.lockstep import ChainedAnswers, stamp_ns
 from swivel_car_ros.ros_params import (
     declare_dataclass, declare_description, is_zero_stamp, live_parameters, run_node,
     stamp_to_seconds, STATE_QUEUE_DEPTH)
+from swivel_car_ros.serialized import (
+    JointStateView, read_joint_state, read_logged, SerializedMessage, STAMP_FORMAT)
 
 # A cmd_vel stamped further than this ahead of the node clock is taken as arriving now.
 _CLOCK_SLACK = 0.5  # [s]
@@ -103,13 +105,15 @@ class ControllerNode(Node):
         self._joint_states = JointStateController(self._core, swivel_joint)
         self._warned_zero_stamp = False
         # When to answer a joint_states in the lockstep chain: docs/architecture.md.
-        self._chain: ChainedAnswers[JointState] = ChainedAnswers(
+        self._chain: ChainedAnswers[JointStateView] = ChainedAnswers(
             round(self._lockstep_wait * 1e9), self._lockstep_swivel_command,
             self._lockstep_cmd_vel)
 
         # Built once, refilled every period: a message constructor imports and builds each
-        # nested message in Python, every time.
-        self._command = ActuatorCommand()
+        # nested message in Python, every time; the command is rewritten in its CDR bytes.
+        self._command = SerializedMessage(ActuatorCommand(), (
+            (STAMP_FORMAT, ('header.stamp.sec', 'header.stamp.nanosec')),
+            ('<2d', ('swivel_torque', 'drive_speed'))))
         self._state = SwivelControllerState()
         self._limited = TwistStamped()
         self._limited.header.frame_id = self._base_frame_id
@@ -118,7 +122,8 @@ class ControllerNode(Node):
         self._state_pub = self.create_publisher(SwivelControllerState, '~/controller_state',
                                                 STATE_QUEUE_DEPTH)
         self._cmd_out_pub = self.create_publisher(TwistStamped, '~/cmd_vel_out', 10)
-        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
+        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10,
+                                 raw=True)
         self.create_subscription(TwistStamped if self._use_stamped else Twist, 'cmd_vel',
                                  self._on_cmd_vel, 10)
         self.create_subscription(SwivelCommand, 'swivel_command', self._on_swivel_command, 10)
@@ -232,17 +237,25 @@ class ControllerNode(Node):
                 '(the run is no longer deterministic)', throttle_duration_sec=5.0)
         self._answer(msg)
 
-    def _on_joint_states(self, msg: JointState) -> None:
-        self._answer(self._chain.state(stamp_ns(msg.header.stamp), msg, self._holding(),
+    def _on_joint_states(self, data: bytes) -> None:
+        msg = read_logged(self.get_logger(), read_joint_state, data, 'joint_states')
+        if msg is None:
+            return
+        self._answer(self._chain.state(stamp_ns(msg.stamp), msg, self._holding(),
                                        time.monotonic_ns()))
 
-    def _answer(self, msg: JointState | None) -> None:
+    def _publish_command(self, stamp: TimeMsg, swivel_torque: float,
+                         drive_speed: float) -> None:
+        command = self._command
+        command.pack(0, stamp.sec, stamp.nanosec)
+        command.pack(1, swivel_torque, drive_speed)
+        self._command_pub.publish(command.serialized())
+
+    def _answer(self, msg: JointStateView | None) -> None:
         """One ActuatorCommand (and controller state) for this joint_states; None: none."""
         if msg is None:
             return
-        stamp = msg.header.stamp
-        command = self._command
-        command.header.stamp = stamp
+        stamp = msg.stamp
         try:
             swivel, out = self._joint_states.answer(
                 stamp_to_seconds(stamp), msg.name, msg.position, msg.velocity)
@@ -250,8 +263,7 @@ class ControllerNode(Node):
             # Still answer the stamp (the lockstep sim waits for it), with the safe command.
             self.get_logger().warn(f'{error}: commanding zero torque and drive',
                                    throttle_duration_sec=5.0)
-            command.swivel_torque = command.drive_speed = 0.0
-            self._command_pub.publish(command)
+            self._publish_command(stamp, 0.0, 0.0)
             return
         if out.cmd_vel_timed_out:
             self.get_logger().info('cmd_vel timed out: drive stopped, swivel held',
@@ -259,9 +271,7 @@ class ControllerNode(Node):
         if out.swivel_command_timed_out:
             self.get_logger().warn('swivel_command timed out (planner gone?): released, drive '
                                    'stopped, swivel held')
-        command.swivel_torque = out.swivel_torque
-        command.drive_speed = out.drive_speed
-        self._command_pub.publish(command)
+        self._publish_command(stamp, out.swivel_torque, out.drive_speed)
 
         state = self._state
         state.header.stamp = stamp

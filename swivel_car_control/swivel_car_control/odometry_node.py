@@ -18,7 +18,8 @@ from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Empty
 from swivel_car_control.conversions import set_yaw
-from swivel_car_control.core.joint_states import JointStateOdometry, YAW_RATE_SOURCES
+from swivel_car_control.core.joint_states import (
+    JointStateOdometry, yaw_quaternion, YAW_RATE_SOURCES)
 from swivel_car_control.core.odometry_input import (
     GatedOdometry, MAX_SWIVEL_RATE, Verdict, WHEEL_RATE_FACTOR)
 from swivel_car_control.joints import MissingJointError
@@ -26,6 +27,8 @@ from swivel_car_msgs.srv import SetPose2D
 from swivel_car_ros.ros_params import (
     declare_dataclass, declare_description, live_parameters, run_node, stamp_to_seconds,
     STATE_QUEUE_DEPTH)
+from swivel_car_ros.serialized import (
+    read_joint_state, read_logged, SerializedMessage, STAMP_FORMAT)
 
 
 @dataclass(frozen=True)
@@ -114,14 +117,19 @@ class OdometryNode(Node):
             config.rear_right_wheel_joint: max_wheel_rate})
         self._tf = self._make_tf_broadcaster() if config.enable_odom_tf else None
         # Built once, refilled every period: a message constructor imports and builds each
-        # nested message in Python, every time.
-        self._odom = Odometry()
-        self._odom.header.frame_id = config.frame(config.odom_frame_id)
-        self._odom.child_frame_id = config.frame(config.base_frame_id)
-        self._transform = TransformStamped()
-        self._transform.header = self._odom.header  # the same stamp and frame
-        self._transform.child_frame_id = self._odom.child_frame_id
-        self._transform.transform.rotation = self._odom.pose.pose.orientation
+        # nested message in Python, every time; the odometry is rewritten in its CDR bytes.
+        odom = Odometry(child_frame_id=config.frame(config.base_frame_id))
+        odom.header.frame_id = config.frame(config.odom_frame_id)
+        self._odom = SerializedMessage(odom, (
+            (STAMP_FORMAT, ('header.stamp.sec', 'header.stamp.nanosec')),
+            ('<7d', tuple(f'pose.pose.position.{c}' for c in 'xyz')
+             + tuple(f'pose.pose.orientation.{c}' for c in 'xyzw')),
+            ('<36d', ('pose.covariance',)),
+            ('<6d', tuple(f'twist.twist.linear.{c}' for c in 'xyz')
+             + tuple(f'twist.twist.angular.{c}' for c in 'xyz')),
+            ('<36d', ('twist.covariance',))))
+        self._transform = TransformStamped(child_frame_id=odom.child_frame_id)
+        self._transform.header.frame_id = odom.header.frame_id
 
         self._apply_config(config)
         live_parameters(self, OdometryConfig.LIVE, self._live_config, self._apply_config)
@@ -130,7 +138,7 @@ class OdometryNode(Node):
         # queued, so it integrates every one instead of dropping them and Euler-stepping the
         # gap with the last rates.
         self.create_subscription(JointState, 'joint_states', self._on_joint_states,
-                                 STATE_QUEUE_DEPTH)
+                                 STATE_QUEUE_DEPTH, raw=True)
         self.create_service(Empty, '~/reset', self._on_reset)
         self.create_service(SetPose2D, '~/set_pose', self._on_set_pose)
 
@@ -143,8 +151,8 @@ class OdometryNode(Node):
 
     def _apply_config(self, config: OdometryConfig) -> None:
         self._config = config
-        self._odom.pose.covariance = _diagonal(config.pose_covariance_diagonal)
-        self._odom.twist.covariance = _diagonal(config.twist_covariance_diagonal)
+        self._odom.pack(2, *_diagonal(config.pose_covariance_diagonal))
+        self._odom.pack(4, *_diagonal(config.twist_covariance_diagonal))
 
     def _make_tf_broadcaster(self):
         try:
@@ -158,8 +166,11 @@ class OdometryNode(Node):
             return None
         return TransformBroadcaster(self)
 
-    def _on_joint_states(self, msg: JointState) -> None:
-        t = stamp_to_seconds(msg.header.stamp)
+    def _on_joint_states(self, data: bytes) -> None:
+        msg = read_logged(self.get_logger(), read_joint_state, data, 'joint_states')
+        if msg is None:
+            return
+        t = stamp_to_seconds(msg.stamp)
         try:
             admission, due = self._gated.update(t, msg.name, msg.position, msg.velocity)
         except MissingJointError as error:
@@ -177,23 +188,22 @@ class OdometryNode(Node):
         # Published on joint_states time, not a timer: in a lockstep sim every run publishes
         # the same poses, and a consumer can wait for the odom of a given state.
         if due:
-            self._publish(msg.header.stamp)
+            self._publish(msg.stamp)
 
     def _publish(self, stamp) -> None:
         odometry = self._odometry
         msg = self._odom
-        msg.header.stamp = stamp
-        msg.pose.pose.position.x = odometry.x
-        msg.pose.pose.position.y = odometry.y
-        set_yaw(msg.pose.pose.orientation, odometry.yaw)
-        msg.twist.twist.linear.x = odometry.v
-        msg.twist.twist.angular.z = odometry.omega
-        self._odom_pub.publish(msg)
+        msg.pack(0, stamp.sec, stamp.nanosec)
+        msg.pack(1, odometry.x, odometry.y, 0.0, *yaw_quaternion(odometry.yaw))
+        msg.pack(3, odometry.v, 0.0, 0.0, 0.0, 0.0, odometry.omega)
+        self._odom_pub.publish(msg.serialized())
         if self._tf is not None:
-            translation = self._transform.transform.translation
-            translation.x = odometry.x
-            translation.y = odometry.y
-            self._tf.sendTransform(self._transform)
+            transform = self._transform
+            transform.header.stamp = stamp
+            transform.transform.translation.x = odometry.x
+            transform.transform.translation.y = odometry.y
+            set_yaw(transform.transform.rotation, odometry.yaw)
+            self._tf.sendTransform(transform)
 
     def _on_reset(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
         self._odometry.reset()

@@ -8,6 +8,7 @@ from builtin_interfaces.msg import Time
 from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan as ClimbPlanMsg
 
 from swivel_car_planner.core import ClimbPlan, ClimbRequest, Outcome
+from swivel_car_ros.serialized import aligned, CDR_START, read_header
 
 
 def request_from(message, with_time_allowance: bool) -> ClimbRequest:
@@ -36,36 +37,9 @@ def outcome_to_msg(outcome: Outcome) -> ClimbOutcome:
         distance_travelled=float(outcome.distance_travelled))
 
 
-# The planner reads odom and imu serialized: deserialising a whole nav_msgs/Odometry (two 6x6
-# covariances) took 134 us and an Imu 45 us of a 10 ms control period on this machine; the few
-# fields it uses are read at their CDR offsets here. Little-endian CDR (XCDR1, as rmw_fastrtps
-# and rmw_cyclonedds send ROS types from x86 and ARM machines): a 4-byte encapsulation header,
-# then each primitive aligned to its size from the end of that header.
-_CDR_LITTLE_ENDIAN = b'\x00\x01'
-_CDR_START = 4  # [B] the encapsulation header
-
-
-def _aligned(offset: int, size: int) -> int:
-    return offset + (-offset) % size
-
-
-def read_header(data: bytes) -> tuple[Time, int]:
-    """
-    Read the std_msgs/Header a serialized message starts with.
-
-    Returns the stamp and the offset after the header (from the end of the encapsulation
-    header).
-
-    Raises
-    ------
-    ValueError
-        Not little-endian plain CDR.
-
-    """
-    if data[:2] != _CDR_LITTLE_ENDIAN:
-        raise ValueError(f'not little-endian plain CDR: encapsulation {bytes(data[:2]).hex()}')
-    sec, nanosec, frame_id_length = struct.unpack_from('<iII', data, _CDR_START)
-    return Time(sec=sec, nanosec=nanosec), 12 + frame_id_length
+# The planner reads its inputs serialized (swivel_car_ros.serialized): deserialising a whole
+# nav_msgs/Odometry (two 6x6 covariances) took 134 us and an Imu 45 us of a 10 ms control
+# period on this machine; the few fields it uses are read at their CDR offsets here.
 
 
 def odom_fields(data: bytes) -> tuple[Time, float, float, tuple[float, float, float, float],
@@ -77,17 +51,34 @@ def odom_fields(data: bytes) -> tuple[Time, float, float, tuple[float, float, fl
     (twist.linear.x) [m/s].
     """
     stamp, offset = read_header(data)
-    offset = _aligned(offset, 4)  # child_frame_id
-    (length,) = struct.unpack_from('<I', data, _CDR_START + offset)
-    offset = _aligned(offset + 4 + length, 8)  # pose.pose.position
-    x, y, _, *orientation = struct.unpack_from('<7d', data, _CDR_START + offset)
+    offset = aligned(offset, 4)  # child_frame_id
+    (length,) = struct.unpack_from('<I', data, CDR_START + offset)
+    offset = aligned(offset + 4 + length, 8)  # pose.pose.position
+    x, y, _, *orientation = struct.unpack_from('<7d', data, CDR_START + offset)
     # After the pose (7 doubles) and its covariance (36): twist.twist.linear.x.
-    (speed,) = struct.unpack_from('<d', data, _CDR_START + offset + 8 * (7 + 36))
+    (speed,) = struct.unpack_from('<d', data, CDR_START + offset + 8 * (7 + 36))
     return stamp, x, y, tuple(orientation), speed
+
+
+def controller_state_fields(data: bytes) -> tuple[Time, float, float, Time]:
+    """
+    Read a serialized swivel_car_msgs/SwivelControllerState.
+
+    Returns stamp, set point [rad], torque [N m] and the stamp of the last swivel_command the
+    controller heard (zero: none).
+    """
+    stamp, offset = read_header(data)
+    offset = aligned(offset, 8)  # set_point, target, measured, measured_rate, error, torque
+    set_point, *_, torque = struct.unpack_from('<6d', data, CDR_START + offset)
+    offset = aligned(offset + 8 * 9 + 1, 8)  # 9 float64 to d_term, bool saturated
+    (length,) = struct.unpack_from('<I', data, CDR_START + offset + 8)  # source, after drive_speed
+    offset = aligned(offset + 8 + 4 + length, 4)
+    sec, nanosec = struct.unpack_from('<iI', data, CDR_START + offset)
+    return stamp, set_point, torque, Time(sec=sec, nanosec=nanosec)
 
 
 def imu_fields(data: bytes) -> tuple[Time, tuple[float, float, float, float]]:
     """Read a serialized sensor_msgs/Imu: its stamp and orientation quaternion (x, y, z, w)."""
     stamp, offset = read_header(data)
-    orientation = struct.unpack_from('<4d', data, _CDR_START + _aligned(offset, 8))
+    orientation = struct.unpack_from('<4d', data, CDR_START + aligned(offset, 8))
     return stamp, orientation

@@ -43,7 +43,7 @@ from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
 from swivel_car_planner.conversions import (
-    imu_fields, odom_fields, outcome_to_msg, plan_to_msg, request_from)
+    controller_state_fields, imu_fields, odom_fields, outcome_to_msg, plan_to_msg, request_from)
 from swivel_car_planner.core import (
     capability, ClimbPlan as Plan, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs,
     make_plan, PlanError, PlannerConfig, validate_request)
@@ -51,6 +51,7 @@ from swivel_car_planner.core.sync import InputSync, Tick
 from swivel_car_ros.lockstep import ChainEntry, Entry
 from swivel_car_ros.ros_params import (
     declare_description, moment_seconds, run_node, stamp_to_seconds)
+from swivel_car_ros.serialized import read_joint_state, read_logged
 
 _CONTROLLER_STATE = inputs.CONTROLLER_STATE
 _INPUTS = inputs.INPUTS
@@ -187,10 +188,11 @@ class PlannerNode(Node):
 
         # Serialized: the planner reads a few fields of each (conversions.odom_fields).
         self.create_subscription(Odometry, 'odom', self._on_odom, 10, raw=True)
-        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
+        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10,
+                                 raw=True)
         self.create_subscription(Imu, 'imu', self._on_imu, 10, raw=True)
         self.create_subscription(SwivelControllerState, _CONTROLLER_STATE,
-                                 self._on_controller_state, 10)
+                                 self._on_controller_state, 10, raw=True)
         self.create_subscription(Header, 'sim/reset_event', self._on_sim_reset, 10)
         self._command_pub = self.create_publisher(SwivelCommand, 'swivel_command', 10)
         self.create_service(ClimbStepService, 'climb_step',
@@ -270,28 +272,35 @@ class PlannerNode(Node):
 
     def _on_odom(self, data: bytes) -> None:
         if self._heard(inputs.ODOM):
-            fields = self._read(odom_fields, data)
+            fields = read_logged(self.get_logger(), odom_fields, data, inputs.ODOM)
             if fields is not None:
                 stamp, x, y, orientation, speed = fields
                 self._add(inputs.ODOM, stamp, inputs.odom_values(x, y, orientation, speed))
 
-    def _on_joint_states(self, msg: JointState) -> None:
+    def _on_joint_states(self, data: bytes) -> None:
+        msg = read_logged(self.get_logger(), read_joint_state, data, inputs.JOINT_STATES)
+        if msg is None:
+            return
         values = inputs.joint_state_values(self._swivel_joint, msg.name, msg.position,
                                            msg.velocity)
         if values is not None and self._heard(inputs.JOINT_STATES):
-            self._add(inputs.JOINT_STATES, msg.header.stamp, values)
+            self._add(inputs.JOINT_STATES, msg.stamp, values)
 
     def _on_imu(self, data: bytes) -> None:
         if self._heard(inputs.IMU):
-            fields = self._read(imu_fields, data)
+            fields = read_logged(self.get_logger(), imu_fields, data, inputs.IMU)
             if fields is not None:
                 stamp, orientation = fields
                 self._add(inputs.IMU, stamp, inputs.imu_values(orientation))
 
-    def _on_controller_state(self, msg: SwivelControllerState) -> None:
+    def _on_controller_state(self, data: bytes) -> None:
         if self._heard(_CONTROLLER_STATE):
-            self._add(_CONTROLLER_STATE, msg.header.stamp, inputs.controller_state_values(
-                msg.set_point, msg.torque, moment_seconds(msg.swivel_command_stamp)))
+            fields = read_logged(self.get_logger(), controller_state_fields, data,
+                                 _CONTROLLER_STATE)
+            if fields is not None:
+                stamp, set_point, torque, command_stamp = fields
+                self._add(_CONTROLLER_STATE, stamp, inputs.controller_state_values(
+                    set_point, torque, moment_seconds(command_stamp)))
 
     def _heard(self, topic: str) -> bool:
         """
@@ -302,13 +311,6 @@ class PlannerNode(Node):
         """
         self._received[topic] = (self._now(), time.monotonic())
         return self._climb is not None
-
-    def _read(self, read: Callable[[bytes], tuple], data: bytes) -> tuple | None:
-        try:
-            return read(data)
-        except ValueError as error:
-            self.get_logger().error(f'input ignored: {error}', throttle_duration_sec=5.0)
-            return None
 
     def _add(self, topic: str, stamp: TimeMsg, value: tuple) -> None:
         for tick in self._sync.add(topic, stamp_to_seconds(stamp), value):

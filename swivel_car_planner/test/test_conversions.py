@@ -1,10 +1,11 @@
-"""The planner's readers of serialized odom and imu against rclpy's own serialization."""
+"""The planner's readers of serialized inputs against rclpy's own serialization."""
 
 from nav_msgs.msg import Odometry
 import pytest
 from rclpy.serialization import serialize_message
 from sensor_msgs.msg import Imu
-from swivel_car_planner.conversions import imu_fields, odom_fields
+from swivel_car_msgs.msg import SwivelControllerState
+from swivel_car_planner.conversions import controller_state_fields, imu_fields, odom_fields
 
 # Frame ids of every length modulo 8: each puts the fields after them at another alignment.
 FRAME_IDS = ['', 'o', 'od', 'odo', 'odom', 'odom_', 'odom_1', 'odom_12', 'base_footprint']
@@ -37,6 +38,21 @@ def test_imu_fields_are_the_messages(frame_id):
     stamp, quaternion = imu_fields(serialize_message(msg))
     assert (stamp.sec, stamp.nanosec) == (7, 10_000_000)
     assert quaternion == (0.01, 0.2, -0.03, 0.97)
+
+
+@pytest.mark.parametrize('frame_id', FRAME_IDS)
+@pytest.mark.parametrize('source', ['', 'hold', 'cmd_vel', 'swivel_command'])
+def test_controller_state_fields_are_the_messages(frame_id, source):
+    msg = SwivelControllerState(set_point=0.25, target=9.0, measured=-1.0, torque=-3.5,
+                                d_term=7.0, saturated=True, drive_speed=2.0, source=source)
+    msg.header.stamp.sec, msg.header.stamp.nanosec = 11, 20_000_000
+    msg.header.frame_id = frame_id
+    msg.swivel_command_stamp.sec, msg.swivel_command_stamp.nanosec = 10, 990_000_000
+    msg.cmd_vel_stamp.sec = 5
+    stamp, set_point, torque, command_stamp = controller_state_fields(serialize_message(msg))
+    assert (stamp.sec, stamp.nanosec) == (11, 20_000_000)
+    assert (set_point, torque) == (0.25, -3.5)
+    assert (command_stamp.sec, command_stamp.nanosec) == (10, 990_000_000)
 
 
 def test_another_encoding_is_refused():

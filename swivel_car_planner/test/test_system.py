@@ -16,6 +16,7 @@ from swivel_car_planner.core import ErrorCode, Phase
 
 HEIGHT = 0.04  # [m] within the rear axle's traction limit (README: measured limits)
 DISTANCE = 1.2  # [m]
+RUN_STEPS = 25  # [1] physics steps the cancel test runs at a time: 5 control periods
 
 
 @pytest.fixture(scope='module')
@@ -69,24 +70,32 @@ def test_infeasible_step_is_refused_without_motion(stack, height, code):
 def test_second_goal_is_refused_and_cancel_stops_the_car_safely(stack):
     stack.spawn_step(HEIGHT, DISTANCE)
     feedback = []
+
+    def run_until(phase: Phase) -> None:
+        # A few control periods at a time, each ending paused: the cancel lands while the
+        # wheel is up however fast the sim runs (pausing on seeing the phase came too late
+        # once the chain ran through the advance before the pause).
+        for _ in range(2000):
+            if feedback and feedback[-1].phase >= phase:
+                return
+            stack.run(RUN_STEPS)
+        raise AssertionError(f'no {phase.name} within 2000 runs: {feedback[-1:]}')
+
+    stack.set_paused(True)
     goal = ClimbStepAction.Goal(step_height=HEIGHT, step_distance=DISTANCE)
     sent = stack.climb_action.send_goal_async(
         goal, feedback_callback=lambda msg: feedback.append(msg.feedback))
     stack.spin_until(sent.done, 30.0, 'goal response')
     handle = sent.result()
     assert handle.accepted
-    stack.spin_until(lambda: feedback and feedback[-1].phase >= Phase.LIFT, 120.0,
-                     'the lift')
+    run_until(Phase.LIFT)
     # A second goal and a service call meanwhile: both refused, the climb goes on.
     second = stack.climb_action.send_goal_async(goal)
     stack.spin_until(second.done, 30.0, 'second goal response')
     assert not second.result().accepted
     busy = stack.climb(HEIGHT, DISTANCE)
     assert busy.error_code == ClimbStep.Response.ERROR_BUSY
-    stack.spin_until(lambda: feedback[-1].phase >= Phase.ADVANCE, 120.0, 'the advance')
-
-    # Paused, so that the cancel lands while the wheel is up however fast the sim runs.
-    stack.set_paused(True)
+    run_until(Phase.ADVANCE)
     assert feedback[-1].phase == Phase.ADVANCE
     cancel = handle.cancel_goal_async()
     stack.spin_until(cancel.done, 30.0, 'the cancel response')

@@ -51,7 +51,8 @@ class SimLockstep:
     advances. With no command for ``timeout_ns`` the controller is taken for gone and the sim
     runs at real time (its actuator watchdog stopping the car) until any command comes, then
     waits again. ``real_time_factor`` caps the pace (0: none) for nodes outside the chain.
-    It also holds the pause, which a free-running sim obeys too.
+    It also holds the pause, which a free-running sim obeys too, and ``run_for``: a number of
+    control periods, then the pause, at the state they end in whatever the machine's speed.
 
     Parameters
     ----------
@@ -76,6 +77,7 @@ class SimLockstep:
         self.min_period_ns = (round(control_period_ns / real_time_factor)
                               if real_time_factor > 0.0 else 0)  # [ns]
         self.paused = paused
+        self.pause_at_ns: int | None = None  # [ns] sim time of the state to pause at
         self.sim_ns = 0  # [ns] sim time of the state a command must answer
         self.reset_ns = 0  # [ns] sim time of the first state after the last reset
         self.command_ready = False  # the command of sim_ns came and is applied
@@ -107,6 +109,9 @@ class SimLockstep:
         due = self._next_due + self.min_period_ns
         self._next_due = due if due >= now_ns else now_ns + self.min_period_ns
         self.published(stamp_ns, now_ns)
+        if self.pause_at_ns is not None and stamp_ns >= self.pause_at_ns:
+            self.paused = True
+            self.pause_at_ns = None
 
     def stepped(self, stamp_ns: int) -> None:
         """Note a ``~/step`` call that moved the sim to ``stamp_ns`` [ns], the time to answer."""
@@ -125,10 +130,27 @@ class SimLockstep:
         self.published(stamp_ns, now_ns)
 
     def set_paused(self, paused: bool, now_ns: int) -> bool:
-        """Pause or resume; the timeout restarts. Return whether to advance now."""
+        """
+        Pause or resume (ending a ``run_for``); the timeout restarts.
+
+        Return whether to advance now.
+        """
         self.paused = paused
+        self.pause_at_ns = None
         self._period_start = now_ns
         return not paused and self.command_ready
+
+    def run_for(self, periods: int, now_ns: int) -> bool:
+        """
+        Resume for ``periods`` (>= 1) control periods, then pause at the state they end in.
+
+        Return whether to advance now. The sim time to pause at is ``pause_at_ns``.
+        """
+        if periods < 1:
+            raise ValueError(f'periods must be >= 1, got {periods}')
+        advance = self.set_paused(False, now_ns)
+        self.pause_at_ns = self.sim_ns + periods * self.control_period_ns
+        return advance
 
     def accepts(self, stamp_ns: int) -> bool:
         """Tell whether a command stamped ``stamp_ns`` [ns] (0: unstamped) may be applied."""

@@ -3,6 +3,7 @@
 import math
 
 from builtin_interfaces.msg import Time
+import pytest
 from swivel_car_ros.lockstep import (
     ChainedAnswers, ChainEntry, Entry, REPUBLISH_PERIOD_NS, SimLockstep, SimTick, stamp_ns)
 
@@ -49,6 +50,23 @@ def test_pause_holds_the_sim_and_restarts_the_timeout():
     assert not s.set_paused(False, now_ns=500 * MS)
     assert s.tick(590 * MS) == SimTick(0, True, False)  # 90 ms since the resume: no timeout
     assert s.tick(601 * MS).timed_out
+
+
+def test_a_run_for_some_periods_pauses_at_the_state_they_end_in():
+    s = sim(paused=True)
+    assert not s.heard(0, now_ns=MS)  # paused: the command waits
+    assert s.run_for(2, now_ns=2 * MS)  # its command is there: advance now
+    assert s.pause_at_ns == 2 * PERIOD
+    s.advanced(PERIOD, now_ns=3 * MS)
+    assert not s.paused and s.heard(PERIOD, now_ns=4 * MS)
+    s.advanced(2 * PERIOD, now_ns=5 * MS)
+    assert s.paused and s.pause_at_ns is None  # at the state of the last period
+    assert not s.heard(2 * PERIOD, now_ns=6 * MS) and s.tick(7 * MS) == WAIT
+    assert s.run_for(1, now_ns=8 * MS)  # the command came while paused: advance now
+    assert s.pause_at_ns == 3 * PERIOD
+    assert not s.set_paused(True, now_ns=9 * MS) and s.pause_at_ns is None  # ends the run
+    with pytest.raises(ValueError, match='periods must be >= 1'):
+        s.run_for(0, now_ns=10 * MS)
 
 
 def test_while_waiting_the_state_is_published_again():

@@ -1,27 +1,26 @@
 """
-RobotState -> serialized ROS messages (thin, no logic beyond field mapping).
+RobotState -> serialized ROS messages and back from the command (field mapping only).
 
 The node publishes four messages every control period. Handing rclpy a message object costs
 it a conversion to C and a serialization per publish (15-35 us for an Odometry here, its
 covariances the most), so each message is serialized once (``StateMessages``) and only the
-bytes of the fields that change are rewritten; rclpy publishes bytes as they are.
+bytes of the fields that change are rewritten (``swivel_car_ros.serialized``); rclpy publishes
+bytes as they are.
 """
 
 from __future__ import annotations
 
-from functools import reduce
 import struct
 
 from builtin_interfaces.msg import Time
 from nav_msgs.msg import Odometry
-from rclpy.serialization import serialize_message
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
+from swivel_car_ros.lockstep import stamp_ns
+from swivel_car_ros.serialized import (
+    aligned, CDR_START, read_header, SerializedMessage, STAMP_FORMAT)
 
 from swivel_car_sim.robot_state import RobotState
-
-# builtin_interfaces/Time as CDR (little endian, what serialize_message gives here).
-STAMP_FORMAT = '<iI'  # int32 sec, uint32 nanosec
 
 
 def sim_time(steps: int, time_step_ns: int) -> tuple[int, int]:
@@ -35,52 +34,21 @@ def sim_time_msg(steps: int, time_step_ns: int) -> Time:
     return Time(sec=sec, nanosec=nanosec)
 
 
-class SerializedMessage:
+def actuator_command_fields(data: bytes) -> tuple[int, float, float]:
     """
-    A message serialized once, whose changing fields are rewritten in place.
+    Read a serialized swivel_car_msgs/ActuatorCommand.
 
-    Parameters
-    ----------
-    msg
-        The message with its constant fields (frame ids, names) set.
-    fields : tuple of (str, tuple of str)
-        Groups of fields consecutive in the serialized message, each a struct format and the
-        fields' dotted paths, rewritten with ``pack(index of the group, *values)``. A
-        float64[] field is a group of one path and the format ``'<Nd'``: its length N is
-        fixed from then on.
+    Returns its stamp [ns], swivel torque [N m] and drive speed [rad/s].
+
+    Raises
+    ------
+    ValueError
+        Not little-endian plain CDR.
 
     """
-
-    def __init__(self, msg, fields: tuple[tuple[str, tuple[str, ...]], ...]) -> None:
-        # Set every group to sentinel values, serialize, and find where they landed.
-        sentinel = 0x5E7CA100  # a clash with other bytes fails the count check below
-        expected = []
-        for fmt, paths in fields:
-            layout = struct.Struct(fmt)
-            count = len(layout.unpack(bytes(layout.size)))
-            values = [sentinel + k + (0.25 if fmt.endswith('d') else 0) for k in range(count)]
-            sentinel += count
-            for path, value in zip(paths, [values] if len(paths) < count else values,
-                                   strict=True):
-                *parents, name = path.split('.')
-                setattr(reduce(getattr, parents, msg), name, value)
-            expected.append((layout, layout.pack(*values)))
-        self._data = bytearray(serialize_message(msg))
-        self._groups = []
-        for layout, packed in expected:
-            if self._data.count(packed) != 1:
-                raise ValueError(f'{type(msg).__name__}: the fields {fields} are not '
-                                 'consecutive in its serialized form')
-            self._groups.append((layout.pack_into, self._data.index(packed)))
-
-    def pack(self, index: int, *values) -> None:
-        """Write ``values`` into the field group ``index`` (in the order of ``fields``)."""
-        pack_into, offset = self._groups[index]
-        pack_into(self._data, offset, *values)
-
-    def serialized(self) -> bytes:
-        """Return the message as it stands, serialized."""
-        return bytes(self._data)
+    stamp, offset = read_header(data)
+    swivel_torque, drive_speed = struct.unpack_from('<2d', data, CDR_START + aligned(offset, 8))
+    return stamp_ns(stamp), swivel_torque, drive_speed
 
 
 class StateMessages:

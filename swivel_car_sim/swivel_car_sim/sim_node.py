@@ -20,10 +20,12 @@ from std_srvs.srv import SetBool
 from swivel_car_msgs.msg import ActuatorCommand
 from swivel_car_msgs.srv import (RemoveObstacle, ResetSimulation, SpawnObstacle,
                                  StepSimulation)
-from swivel_car_ros.lockstep import SimLockstep, stamp_ns
+from swivel_car_ros.lockstep import SimLockstep
 from swivel_car_ros.ros_params import run_node, STATE_QUEUE_DEPTH
+from swivel_car_ros.serialized import read_logged
 from swivel_car_sim.config import PARAMETERS, SimNodeConfig
-from swivel_car_sim.conversions import sim_time, sim_time_msg, StateMessages
+from swivel_car_sim.conversions import (
+    actuator_command_fields, sim_time, sim_time_msg, StateMessages)
 from swivel_car_sim.physics import MAX_STEPS_PER_CALL, SwivelCarSim
 from swivel_car_sim.world import StepSpec
 
@@ -64,10 +66,12 @@ class SimNode(Node):
         self._odom_pub = self.create_publisher(Odometry, 'ground_truth/odom',
                                                STATE_QUEUE_DEPTH)
         self._reset_pub = self.create_publisher(Header, '~/reset_event', 10)
-        self.create_subscription(ActuatorCommand, 'actuator_command', self._on_command, 10)
+        self.create_subscription(ActuatorCommand, 'actuator_command', self._on_command, 10,
+                                 raw=True)
         self.create_service(ResetSimulation, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/set_paused', self._on_set_paused)
         self.create_service(StepSimulation, '~/step', self._on_step)
+        self.create_service(StepSimulation, '~/run', self._on_run)
         self.create_service(SpawnObstacle, '~/spawn_obstacle', self._on_spawn)
         self.create_service(RemoveObstacle, '~/remove_obstacle', self._on_remove)
 
@@ -146,14 +150,18 @@ class SimNode(Node):
 
     # --- callbacks -------------------------------------------------------------------------
 
-    def _on_command(self, msg: ActuatorCommand) -> None:
-        computed = stamp_ns(msg.header.stamp)  # [ns]
+    def _on_command(self, data: bytes) -> None:
+        fields = read_logged(self.get_logger(), actuator_command_fields, data,
+                             'actuator_command')
+        if fields is None:
+            return
+        computed, swivel_torque, drive_speed = fields  # [ns], [N m], [rad/s]
         if not self._lockstep.accepts(computed):
             return  # it answers a state of the world before the last reset
         if self._stale(computed):
             return
         try:
-            self.sim.set_command(msg.swivel_torque, msg.drive_speed)
+            self.sim.set_command(swivel_torque, drive_speed)
         except ValueError as error:
             self.get_logger().warn(f'ignoring actuator_command: {error}',
                                    throttle_duration_sec=1.0)
@@ -210,6 +218,23 @@ class SimNode(Node):
             response.success = True
             response.message = f'stepped {request.steps} steps'
         response.sim_time = self._stamp()
+        return response
+
+    def _on_run(self, request: StepSimulation.Request, response: StepSimulation.Response):
+        if not 1 <= request.steps <= MAX_STEPS_PER_CALL:
+            response.success = False
+            response.message = f'steps must be in [1, {MAX_STEPS_PER_CALL}], got {request.steps}'
+            response.sim_time = self._stamp()
+            return response
+        periods = -(-request.steps // self.config.steps_per_period)  # rounded up
+        advance = self._lockstep.run_for(periods, time.monotonic_ns())
+        pause_at_ns = self._lockstep.pause_at_ns  # [ns]
+        response.success = True
+        response.message = (f'running {periods} control periods, then pausing at '
+                            f'{pause_at_ns * 1e-9:.3f} s')
+        response.sim_time = sim_time_msg(pause_at_ns // self._time_step_ns, self._time_step_ns)
+        if advance:
+            self._advance()
         return response
 
     def _on_reset(self, request: ResetSimulation.Request, response: ResetSimulation.Response):

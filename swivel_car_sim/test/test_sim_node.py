@@ -233,6 +233,25 @@ def test_pause_stops_free_running_and_step_moves_it(harness_factory):
     assert not refused.success and 'pause' in refused.message
 
 
+def test_run_advances_whole_periods_and_pauses_at_the_state_they_end_in(harness_factory):
+    h = harness_factory(real_time_factor=0.0, start_paused=True)
+    response = h.call(StepSimulation, 'run', StepSimulation.Request(steps=23))
+    assert response.success, response.message
+    assert _ns(response.sim_time) == 25 * 2_000_000  # rounded up to 5 periods of 5 steps
+    spin_until(h.executor, lambda: h.sim.sim.steps >= 25, TIMEOUT, 'the run')
+    for _ in range(20):
+        h.executor.spin_once(timeout_sec=0.01)
+    assert h.sim.sim.steps == 25  # paused there
+    refused = h.call(StepSimulation, 'run', StepSimulation.Request(steps=0))
+    assert not refused.success and 'steps must be in [1, 100000]' in refused.message
+    assert h.call(StepSimulation, 'run', StepSimulation.Request(steps=100_000)).success
+    assert h.call(SetBool, 'set_paused', SetBool.Request(data=True)).success  # ends it early
+    steps = h.sim.sim.steps
+    for _ in range(20):
+        h.executor.spin_once(timeout_sec=0.01)
+    assert h.sim.sim.steps == steps < 100_025
+
+
 @pytest.mark.parametrize('change, message', [
     ({'height': math.nan}, 'height must be a finite number'), ({'height': -0.1}, 'height'),
     ({'distance': 0.0, 'height': 0.05}, 'overlap'), ({'yaw': 2.0}, 'yaw')])

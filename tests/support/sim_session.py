@@ -24,7 +24,7 @@ from std_srvs.srv import Empty, SetBool
 from swivel_car_model.description import CarDescription
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
-from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
+from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle, StepSimulation
 from swivel_car_planner.ground_truth import GroundTruth
 
 try:
@@ -121,6 +121,7 @@ class SimSession:
         self.spawn_client = self.node.create_client(SpawnObstacle, 'sim/spawn_obstacle')
         self.reset_client = self.node.create_client(ResetSimulation, 'sim/reset')
         self.pause_client = self.node.create_client(SetBool, 'sim/set_paused')
+        self.run_client = self.node.create_client(StepSimulation, 'sim/run')
         self.odometry_reset = self.node.create_client(Empty, 'odometry/reset')
         self.climb_client = self.node.create_client(ClimbStep, 'climb_step')
         self.climb_action = ActionClient(self.node, ClimbStepAction, 'climb_step')
@@ -157,7 +158,7 @@ class SimSession:
 
         Running: the sim, the controller and the odometry publish, and the planner hears them.
         """
-        clients = [self.spawn_client, self.reset_client, self.pause_client,
+        clients = [self.spawn_client, self.reset_client, self.pause_client, self.run_client,
                    self.odometry_reset]
         if self._planner:
             clients.append(self.climb_client)
@@ -217,6 +218,24 @@ class SimSession:
         response = self.call(self.pause_client, SetBool.Request(data=paused), resend=True)
         if not response.success:
             raise RuntimeError(f'sim set_paused failed: {response.message}')
+
+    def run(self, steps: int) -> None:
+        """
+        Run ``steps`` physics steps (whole control periods) and hold the sim paused there.
+
+        Returns once the controller has answered the state the sim paused at, whatever the
+        machine's speed: where the sim stops does not depend on when this node acts.
+        """
+        response = self.call(self.run_client, StepSimulation.Request(steps=steps))
+        if not response.success:
+            raise RuntimeError(f'sim run failed: {response.message}')
+        end = response.sim_time.sec * 1_000_000_000 + response.sim_time.nanosec  # [ns]
+
+        def answered() -> bool:
+            stamp = self.controller_state.header.stamp
+            return stamp.sec * 1_000_000_000 + stamp.nanosec >= end
+
+        self.spin_until(answered, 60.0, f'the sim to run until {end * 1e-9:.3f} s')
 
     def settle(self, seconds: float) -> None:
         """Let ``seconds`` of sim time pass while spinning (the sim keeps stepping)."""
