@@ -11,7 +11,7 @@ One control period of the ROS chain, and of ``InProcessStack``:
    the planner's command stamped with the previous period, giving the actuator command and
    the controller state of t;
 3. the odometry integrates the state of t (``JointStateOdometry``);
-4. the planner, with all four inputs of t (``core.sync.InputSync``), steps the climb state
+4. the planner, with all three inputs of t (``core.sync.InputSync``), steps the climb state
    machine once; its command takes effect at the controller's next answer, one period later;
 5. the sim applies the actuator command of t and advances one control period.
 
@@ -134,8 +134,9 @@ class StackConfig:
     whole_car_limit : float
         The planner's, from its capability table (``capability_file``). # [m]
     steer_joint : str
-        The joint the controller, odometry and planner read ('swivel_joint', or
-        'steering_joint' for the car-like baseline).
+        The joint the controller and the odometry read ('swivel_joint', or
+        'steering_joint' for the car-like baseline); the planner takes it from the
+        controller's state.
     rear_left_wheel_joint, rear_right_wheel_joint : str
     yaw_rate_source : str
         The odometry's ('swivel' or 'rear_wheels').
@@ -219,7 +220,6 @@ class StackConfig:
                                  'odometry_node.yaml')
         robot_description = sim_config.physics.description
         table, _ = capability.table_for(p.get('capability_file', capability.INSTALLED))
-        # The planner's swivel_joint must be the controller's: one joint steers.
         return cls(
             sim=sim_config,
             robot=robot_description,
@@ -510,8 +510,8 @@ class InProcessStack:
         if self._cmd_vel is not None:
             self.controller.core.set_cmd_vel(*self._cmd_vel, t)
         try:
-            _, out = self._timed('controller', self.controller.answer, t, names, positions,
-                                 velocities)
+            swivel, out = self._timed('controller', self.controller.answer, t, names,
+                                      positions, velocities)
         except MissingJointError:
             out = None  # the node answers with zero torque and drive
         self.last_output = out
@@ -524,12 +524,8 @@ class InProcessStack:
         except ValueError:  # MissingJointError too: not updated, nothing published
             odom_due = False
 
-        # planner_node: its four inputs of t; a tick steps the running climb.
+        # planner_node: its three inputs of t; a tick steps the running climb.
         ticks = []
-        joint_values = inputs.joint_state_values(self.config.steer_joint, names, positions,
-                                                 velocities)
-        if joint_values is not None:
-            ticks += self._sync.add(inputs.JOINT_STATES, t, joint_values)
         if self._periods % self.config.sim.imu_every == 0:
             ticks += self._sync.add(inputs.IMU, t, inputs.imu_values(orientation))
         if odom_due:
@@ -538,7 +534,8 @@ class InProcessStack:
                 o.x, o.y, yaw_quaternion(o.yaw), o.v))
         if out is not None:
             ticks += self._sync.add(inputs.CONTROLLER_STATE, t, inputs.controller_state_values(
-                out.set_point, out.swivel_torque, self._command_heard))
+                out.set_point, out.swivel_torque, self._command_heard, swivel.position,
+                swivel.rate))
         for tick in ticks:
             self._on_tick(tick)
 

@@ -60,21 +60,22 @@ def odom_fields(data: bytes) -> tuple[Time, float, float, tuple[float, float, fl
     return stamp, x, y, tuple(orientation), speed
 
 
-def controller_state_fields(data: bytes) -> tuple[Time, float, float, Time]:
+def controller_state_fields(data: bytes) -> tuple[Time, float, float, float, float, Time]:
     """
     Read a serialized swivel_car_msgs/SwivelControllerState.
 
-    Returns stamp, set point [rad], torque [N m] and the stamp of the last swivel_command the
-    controller heard (zero: none).
+    Returns stamp, set point [rad], measured swivel angle [rad] and rate [rad/s], torque [N m]
+    and the stamp of the last swivel_command the controller heard (zero: none).
     """
     stamp, offset = read_header(data)
     offset = aligned(offset, 8)  # set_point, target, measured, measured_rate, error, torque
-    set_point, *_, torque = struct.unpack_from('<6d', data, CDR_START + offset)
+    set_point, _, measured, measured_rate, _, torque = struct.unpack_from(
+        '<6d', data, CDR_START + offset)
     offset = aligned(offset + 8 * 9 + 1, 8)  # 9 float64 to d_term, bool saturated
     (length,) = struct.unpack_from('<I', data, CDR_START + offset + 8)  # source, after drive_speed
     offset = aligned(offset + 8 + 4 + length, 4)
     sec, nanosec = struct.unpack_from('<iI', data, CDR_START + offset)
-    return stamp, set_point, torque, Time(sec=sec, nanosec=nanosec)
+    return stamp, set_point, measured, measured_rate, torque, Time(sec=sec, nanosec=nanosec)
 
 
 def imu_fields(data: bytes) -> tuple[Time, tuple[float, float, float, float]]:

@@ -35,7 +35,7 @@ from rclpy.node import Node
 from rclpy.service import Service
 from rclpy.task import Future
 from rclpy.time import Time
-from sensor_msgs.msg import Imu, JointState
+from sensor_msgs.msg import Imu
 from std_msgs.msg import Header
 from swivel_car_model import dynamics, kinematics
 from swivel_car_model.checks import check_number
@@ -51,7 +51,7 @@ from swivel_car_planner.core.sync import InputSync, Tick
 from swivel_car_ros.lockstep import ChainEntry, Entry
 from swivel_car_ros.ros_params import (
     declare_description, moment_seconds, run_node, stamp_to_seconds)
-from swivel_car_ros.serialized import read_joint_state, read_logged
+from swivel_car_ros.serialized import read_logged
 
 _CONTROLLER_STATE = inputs.CONTROLLER_STATE
 _INPUTS = inputs.INPUTS
@@ -168,10 +168,6 @@ class PlannerNode(Node):
         self._ready_timeout = self._positive_parameter(
             'ready_timeout', 1.0, 'inputs older than this (in sim and wall time) mean not '
                                   'ready; a climb whose inputs stop for this long aborts [s]')
-        self._swivel_joint = self.declare_parameter(
-            'swivel_joint', 'swivel_joint',
-            ParameterDescriptor(description='name of the swivel joint in joint_states',
-                                read_only=True)).value
 
         self._climb: _ActiveClimb | None = None
         self._planning = False  # a climb's plan is being made (the climb slot is taken)
@@ -188,8 +184,6 @@ class PlannerNode(Node):
 
         # Serialized: the planner reads a few fields of each (conversions.odom_fields).
         self.create_subscription(Odometry, 'odom', self._on_odom, 10, raw=True)
-        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10,
-                                 raw=True)
         self.create_subscription(Imu, 'imu', self._on_imu, 10, raw=True)
         self.create_subscription(SwivelControllerState, _CONTROLLER_STATE,
                                  self._on_controller_state, 10, raw=True)
@@ -277,15 +271,6 @@ class PlannerNode(Node):
                 stamp, x, y, orientation, speed = fields
                 self._add(inputs.ODOM, stamp, inputs.odom_values(x, y, orientation, speed))
 
-    def _on_joint_states(self, data: bytes) -> None:
-        msg = read_logged(self.get_logger(), read_joint_state, data, inputs.JOINT_STATES)
-        if msg is None:
-            return
-        values = inputs.joint_state_values(self._swivel_joint, msg.name, msg.position,
-                                           msg.velocity)
-        if values is not None and self._heard(inputs.JOINT_STATES):
-            self._add(inputs.JOINT_STATES, msg.stamp, values)
-
     def _on_imu(self, data: bytes) -> None:
         if self._heard(inputs.IMU):
             fields = read_logged(self.get_logger(), imu_fields, data, inputs.IMU)
@@ -298,9 +283,9 @@ class PlannerNode(Node):
             fields = read_logged(self.get_logger(), controller_state_fields, data,
                                  _CONTROLLER_STATE)
             if fields is not None:
-                stamp, set_point, torque, command_stamp = fields
+                stamp, set_point, swivel, swivel_rate, torque, command_stamp = fields
                 self._add(_CONTROLLER_STATE, stamp, inputs.controller_state_values(
-                    set_point, torque, moment_seconds(command_stamp)))
+                    set_point, torque, moment_seconds(command_stamp), swivel, swivel_rate))
 
     def _heard(self, topic: str) -> bool:
         """

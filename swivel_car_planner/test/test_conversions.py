@@ -43,15 +43,17 @@ def test_imu_fields_are_the_messages(frame_id):
 @pytest.mark.parametrize('frame_id', FRAME_IDS)
 @pytest.mark.parametrize('source', ['', 'hold', 'cmd_vel', 'swivel_command'])
 def test_controller_state_fields_are_the_messages(frame_id, source):
-    msg = SwivelControllerState(set_point=0.25, target=9.0, measured=-1.0, torque=-3.5,
-                                d_term=7.0, saturated=True, drive_speed=2.0, source=source)
+    msg = SwivelControllerState(set_point=0.25, target=9.0, measured=-1.0, measured_rate=0.5,
+                                torque=-3.5, d_term=7.0, saturated=True, drive_speed=2.0,
+                                source=source)
     msg.header.stamp.sec, msg.header.stamp.nanosec = 11, 20_000_000
     msg.header.frame_id = frame_id
     msg.swivel_command_stamp.sec, msg.swivel_command_stamp.nanosec = 10, 990_000_000
     msg.cmd_vel_stamp.sec = 5
-    stamp, set_point, torque, command_stamp = controller_state_fields(serialize_message(msg))
+    stamp, set_point, swivel, swivel_rate, torque, command_stamp = controller_state_fields(
+        serialize_message(msg))
     assert (stamp.sec, stamp.nanosec) == (11, 20_000_000)
-    assert (set_point, torque) == (0.25, -3.5)
+    assert (set_point, swivel, swivel_rate, torque) == (0.25, -1.0, 0.5, -3.5)
     assert (command_stamp.sec, command_stamp.nanosec) == (10, 990_000_000)
 
 

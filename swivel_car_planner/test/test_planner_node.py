@@ -1,8 +1,8 @@
 """
 Node tests: the real PlannerNode in-process with real rclpy, fed by a kinematic car.
 
-The test plays the robot: it publishes /clock, joint_states, imu, odom and the controller
-state of ``KinematicCar`` (the model's planar kinematics) and applies the planner's
+The test plays the robot: it publishes /clock, imu, odom and the controller state (with the
+swivel) of ``KinematicCar`` (the model's planar kinematics) and applies the planner's
 swivel_command to it, so the service and action run whole climbs without the sim.
 """
 
@@ -23,7 +23,7 @@ from rclpy.action import ActionClient
 from rclpy.experimental import EventsExecutor
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import Imu, JointState
+from sensor_msgs.msg import Imu
 from std_msgs.msg import Header
 from swivel_car_model import description
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
@@ -73,7 +73,6 @@ class Rig:
         self.heard = TimeMsg()  # the stamp of the last command, as the controller reports it
         self.node.create_subscription(SwivelCommand, 'swivel_command', self._on_command, 10)
         self.clock = self.node.create_publisher(Clock, '/clock', 10)
-        self.joints = self.node.create_publisher(JointState, 'joint_states', 10)
         self.imu = self.node.create_publisher(Imu, 'imu', 10)
         self.odom = self.node.create_publisher(Odometry, 'odom', 10)
         self.state = self.node.create_publisher(
@@ -95,7 +94,7 @@ class Rig:
         if rclpy.time.Time.from_msg(msg.header.stamp).nanoseconds == self.car.cycles * 10**7:
             self.command = Command(msg.angle, msg.max_rate, msg.drive_speed, msg.hold)
 
-    def publish_state(self, inputs=('joint_states', 'imu', 'odom', 'controller'),
+    def publish_state(self, inputs=('imu', 'odom', 'controller'),
                       heard=None):
         """
         Publish one control cycle of the robot: clock, then the requested inputs.
@@ -106,11 +105,6 @@ class Rig:
         stamp = rclpy.time.Time(nanoseconds=car.cycles * 10_000_000).to_msg()
         self.clock.publish(Clock(clock=stamp))
         obs = car.observe()
-        if 'joint_states' in inputs:
-            msg = JointState(name=['swivel_joint'], position=[car.swivel],
-                             velocity=[car.rate], effort=[0.0])
-            msg.header.stamp = stamp
-            self.joints.publish(msg)
         if 'imu' in inputs:
             msg = Imu()
             msg.header.stamp = stamp
@@ -130,7 +124,8 @@ class Rig:
             self.odom.publish(msg)
         if 'controller' in inputs:
             msg = SwivelControllerState(set_point=car.set_point, measured=car.swivel,
-                                        torque=obs.torque, source='hold',
+                                        measured_rate=car.rate, torque=obs.torque,
+                                        source='hold',
                                         swivel_command_stamp=self.heard if heard is None
                                         else heard)
             msg.header.stamp = stamp
@@ -161,7 +156,7 @@ class Rig:
         spin_until(self.executor, future.done, 10.0, 'the result')
         return future.result()
 
-    def warm_up(self, cycles=30, inputs=('joint_states', 'imu', 'odom', 'controller')):
+    def warm_up(self, cycles=30, inputs=('imu', 'odom', 'controller')):
         for _ in range(cycles):
             self.publish_state(inputs)
             self.car.cycles += 1
@@ -209,7 +204,7 @@ def test_malformed_request_is_invalid_and_nothing_moves(rig):
 def test_request_before_the_robot_is_up_is_not_ready(rig):
     response = result_of(rig, rig.call(**SUCCESSFUL_CLIMB))
     assert response.error_code == ClimbStepService.Response.ERROR_NOT_READY
-    rig.warm_up(inputs=('joint_states', 'imu', 'controller'))  # no odometry
+    rig.warm_up(inputs=('imu', 'controller'))  # no odometry
     response = result_of(rig, rig.call(**SUCCESSFUL_CLIMB))
     assert response.error_code == ClimbStepService.Response.ERROR_NOT_READY
     assert 'odom' in response.message
@@ -234,7 +229,7 @@ def test_a_clock_ahead_of_the_queued_inputs_is_ready_a_silent_input_is_not(rig):
     # The odometry stops; the rest goes on for more than ready_timeout (1 s) of both clocks.
     start = time.monotonic()
     while time.monotonic() < start + 1.2:
-        rig.warm_up(cycles=1, inputs=('joint_states', 'imu', 'controller'))
+        rig.warm_up(cycles=1, inputs=('imu', 'controller'))
     response = result_of(rig, rig.call(step_height=0.5, step_distance=1.0))
     assert response.error_code == ErrorCode.NOT_READY
     assert response.message.startswith('no recent message on odom: '), response.message
@@ -344,7 +339,7 @@ def test_inputs_stopping_mid_climb_abort_it(rig):
     rig.drive(_Deadline(rig, 1.0))
     # The odometry dies: the planner hears no complete moment for ready_timeout (1 s).
     while not future.done() and rig.car.time < 10.0:
-        rig.publish_state(inputs=('joint_states', 'imu', 'controller'))
+        rig.publish_state(inputs=('imu', 'controller'))
         rig.car.cycles += 1
         rig.executor.spin_once(timeout_sec=0.005)
     response = result_of(rig, future)

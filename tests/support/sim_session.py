@@ -80,15 +80,15 @@ class SimSession:
         # The car-like baseline steers a turntable joint; the controller drives it the same way.
         joint = {'swivel_joint': 'steering_joint' if robot_variant == 'car_like'
                  else 'swivel_joint'}
-        sim_time = {'use_sim_time': True, **joint}
+        sim_time = {'use_sim_time': True}
         # In the lockstep chain the planner's climbs do not depend on the machine's load, and
         # nothing outside it drives the car: the sim runs as fast as the chain answers.
         # Paused until this node has discovered the stack (some 2.3 s after the sim is up): an
         # unpaced sim otherwise ran 20-45 s of sim time for nothing meanwhile.
         sim = {'robot_variant': robot_variant, 'start_paused': True, **robot}
         specs = [('swivel_car_sim', 'sim_node', sim),
-                 ('swivel_car_control', 'controller_node', {**sim_time, **robot}),
-                 ('swivel_car_control', 'odometry_node', {**sim_time, **robot})]
+                 ('swivel_car_control', 'controller_node', {**sim_time, **joint, **robot}),
+                 ('swivel_car_control', 'odometry_node', {**sim_time, **joint, **robot})]
         if planner:
             specs.append(('swivel_car_planner', 'planner_node',
                           {**sim_time, **robot, **(planner_parameters or {})}))

@@ -17,12 +17,14 @@ from typing import Sequence
 from swivel_car_planner.core.state_machine import Command, Observation, Outcome
 from swivel_car_planner.core.sync import Tick
 
-JOINT_STATES = 'joint_states'
 IMU = 'imu'
 ODOM = 'odom'
+# The swivel comes in it too: the controller measured it from the joint_states it answers,
+# with the same stamp, so the planner need not take every joint_states as well (one message
+# fewer per control period through the chain's busiest publisher).
 CONTROLLER_STATE = 'controller/controller_state'
 # Every input topic; a tick comes with each controller state.
-INPUTS = (JOINT_STATES, IMU, ODOM, CONTROLLER_STATE)
+INPUTS = (IMU, ODOM, CONTROLLER_STATE)
 
 # After a failed climb the planner releases the swivel to the controller's hold.
 RELEASE = Command(0.0, 0.0, 0.0, False)
@@ -51,37 +53,21 @@ def odom_values(x: float, y: float, orientation: Sequence[float],
     return x, y, yaw_of(*orientation), speed
 
 
-def joint_state_values(swivel_joint: str, names: Sequence[str], positions: Sequence[float],
-                       velocities: Sequence[float]) -> tuple[float, float] | None:
-    """
-    Return the planner's values of ``joint_states``.
-
-    (swivel angle [rad], swivel rate [rad/s], 0 when not reported); None when the message
-    has no position for ``swivel_joint`` (it is ignored).
-    """
-    if swivel_joint not in names:
-        return None
-    index = list(names).index(swivel_joint)
-    if index >= len(positions):
-        return None
-    rate = velocities[index] if index < len(velocities) else 0.0
-    return float(positions[index]), float(rate)
-
-
 def imu_values(orientation: Sequence[float]) -> tuple[float, float, float]:
     """``imu`` orientation quaternion (x, y, z, w) -> (roll, pitch, yaw) [rad]."""
     return (*roll_pitch(*orientation), yaw_of(*orientation))
 
 
-def controller_state_values(set_point: float, torque: float,
-                            command_stamp: float) -> tuple[float, float, float]:
+def controller_state_values(set_point: float, torque: float, command_stamp: float,
+                            swivel: float, swivel_rate: float
+                            ) -> tuple[float, float, float, float, float]:
     """
     Return the planner's values of ``controller/controller_state``.
 
     (set point [rad], torque [N m], stamp of the last swivel_command the controller heard
-    [s], -inf for none).
+    [s], -inf for none, measured swivel angle [rad] and rate [rad/s]).
     """
-    return set_point, torque, command_stamp
+    return set_point, torque, command_stamp, swivel, swivel_rate
 
 
 def command_heard(tick: Tick) -> float:
@@ -92,9 +78,8 @@ def command_heard(tick: Tick) -> float:
 def observation(tick: Tick) -> Observation:
     """Make the state machine's view of one synchronised moment of all ``INPUTS``."""
     x, y, yaw, speed = tick.values[ODOM]
-    swivel, swivel_rate = tick.values[JOINT_STATES]
     roll, pitch, imu_yaw = tick.values[IMU]
-    set_point, torque, _ = tick.values[CONTROLLER_STATE]
+    set_point, torque, _, swivel, swivel_rate = tick.values[CONTROLLER_STATE]
     return Observation(
         time=tick.time, x=x, y=y, yaw=yaw, swivel=swivel, swivel_rate=swivel_rate,
         set_point=set_point, torque=torque, roll=roll, pitch=pitch, imu_yaw=imu_yaw,
