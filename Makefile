@@ -48,6 +48,11 @@ $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	@# A file removed from a package leaves a dangling symlink that fails the symlink install.
 	find ros2_ws/build ros2_ws/install -xtype l -delete 2>/dev/null || true
 	rm -f ros2_ws/install/.swivel_car_built_*
+	@# Each colcon marks a new build and install directory at its start: two at once on a fresh
+	@# workspace, one read the other's marker while it was being written and refused the build.
+	cd ros2_ws && ../$(IN_WS) python -c 'from colcon_core.verb import check_and_mark_build_tool \
+	    as build, check_and_mark_install_layout as install; build("build"); \
+	    install("install", merge_install=False)'
 	cd ros2_ws && { ../$(IN_WS) colcon --log-base log/python_packages build $(COLCON_BUILD_ARGS) \
 	    --packages-ignore swivel_car_msgs & python_packages=$$!; }; \
 	MAKEFLAGS=-j$$(nproc) ../$(IN_WS) colcon build $(COLCON_BUILD_ARGS) --packages-select swivel_car_msgs \
