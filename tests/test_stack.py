@@ -196,7 +196,13 @@ class Stack:
             for name, process in self.processes.items():
                 assert process.running(), f'{name} died:\n{process.output()[-3000:]}'
             return condition()
-        spin_until(self.executor, checked, timeout, what)
+        try:
+            spin_until(self.executor, checked, timeout, what)
+        except TimeoutError as error:
+            # What each node said is the only trace of why a wait ran out.
+            raise TimeoutError('\n'.join([str(error)] + [
+                f'--- {name}:\n{process.output()[-1500:]}'
+                for name, process in self.processes.items()])) from None
 
     def call(self, client, request, what: str):
         self.spin_until(client.service_is_ready, 60.0, f'the {what} service')
