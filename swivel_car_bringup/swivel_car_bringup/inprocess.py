@@ -54,7 +54,7 @@ from swivel_car_sim.world import StepSpec
 import yaml
 
 ROBOT_VARIANTS = ('swivel', 'car_like')
-# The joint the controller, odometry and planner steer by, per robot variant (the car-like
+# The joint the controller and the odometry steer by, per robot variant (the car-like
 # baseline steers a turntable joint; SimSession sets the same).
 _STEER_JOINT = {'swivel': 'swivel_joint', 'car_like': 'steering_joint'}
 # Parameters only the ROS side of a node reads: accepted in overrides, without effect here.
