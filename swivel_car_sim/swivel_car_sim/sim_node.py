@@ -197,13 +197,20 @@ class SimNode(Node):
             self._advance()
         return response
 
+    @staticmethod
+    def _steps_refusal(steps: int) -> str | None:
+        """Why a ~/step or ~/run request of ``steps`` is refused; None: it is not."""
+        if 1 <= steps <= MAX_STEPS_PER_CALL:
+            return None
+        return f'steps must be in [1, {MAX_STEPS_PER_CALL}], got {steps}'
+
     def _on_step(self, request: StepSimulation.Request, response: StepSimulation.Response):
-        if not 1 <= request.steps <= MAX_STEPS_PER_CALL:
+        refusal = self._steps_refusal(request.steps)
+        if refusal is None and not (self._lockstep.paused or self.config.lockstep):
+            refusal = 'the sim is free running: pause it (~/set_paused) or use lockstep'
+        if refusal is not None:
             response.success = False
-            response.message = f'steps must be in [1, {MAX_STEPS_PER_CALL}], got {request.steps}'
-        elif not (self._lockstep.paused or self.config.lockstep):
-            response.success = False
-            response.message = 'the sim is free running: pause it (~/set_paused) or use lockstep'
+            response.message = refusal
         else:
             remaining = request.steps
             per_period = self.config.steps_per_period
@@ -221,9 +228,10 @@ class SimNode(Node):
         return response
 
     def _on_run(self, request: StepSimulation.Request, response: StepSimulation.Response):
-        if not 1 <= request.steps <= MAX_STEPS_PER_CALL:
+        refusal = self._steps_refusal(request.steps)
+        if refusal is not None:
             response.success = False
-            response.message = f'steps must be in [1, {MAX_STEPS_PER_CALL}], got {request.steps}'
+            response.message = refusal
             response.sim_time = self._stamp()
             return response
         periods = -(-request.steps // self.config.steps_per_period)  # rounded up
