@@ -149,6 +149,13 @@ class NodeProcess:
         self._forget_log()
 
 
+def process_report(processes: Iterable[NodeProcess], chars: int = 1500) -> str:
+    """Each process: running or its exit code, and the last ``chars`` of what it printed."""
+    return '\n'.join(
+        f'--- {p.name}: {"running" if p.running() else f"exited {p.process.returncode}"}'
+        f'\n{p.output()[-chars:]}' for p in processes)
+
+
 def config_path(package: str, file_name: str) -> Path:
     """Return an installed parameter file: share/<package>/config/<file_name>."""
     path = INSTALL_DIR / package / 'share' / package / 'config' / file_name

@@ -47,7 +47,8 @@ from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerSta
 from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
 from swivel_car_ros.ros_params import moment_seconds, stamp_to_seconds
 from swivel_car_testing import (
-    lockstep_parameters, next_domain_id, NodeProcess, resume_sim, spin_until, start_node)
+    lockstep_parameters, next_domain_id, NodeProcess, process_report, resume_sim, spin_until,
+    start_node)
 
 NODES = {'sim': ('swivel_car_sim', 'sim_node'),
          'controller': ('swivel_car_control', 'controller_node'),
@@ -200,9 +201,8 @@ class Stack:
             spin_until(self.executor, checked, timeout, what)
         except TimeoutError as error:
             # What each node said is the only trace of why a wait ran out.
-            raise TimeoutError('\n'.join([str(error)] + [
-                f'--- {name}:\n{process.output()[-1500:]}'
-                for name, process in self.processes.items()])) from None
+            raise TimeoutError(
+                f'{error}\n{process_report(self.processes.values())}') from None
 
     def call(self, client, request, what: str):
         self.spin_until(client.service_is_ready, 60.0, f'the {what} service')

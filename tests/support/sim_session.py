@@ -16,6 +16,7 @@ import sys
 import time
 from typing import Any, Callable
 
+from builtin_interfaces.msg import Time as TimeMsg
 from nav_msgs.msg import Odometry
 import rclpy
 from rclpy.action import ActionClient
@@ -26,6 +27,7 @@ from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle, StepSimulation
 from swivel_car_planner.ground_truth import GroundTruth
+from swivel_car_ros.lockstep import stamp_ns
 
 try:
     from swivel_car_testing import next_domain_id, spin_until
@@ -33,14 +35,13 @@ except ImportError:  # outside pytest: the repository's helpers (pytest.ini puts
     _REPO = Path(__file__).resolve().parents[2]
     sys.path += [str(_REPO / 'scripts'), str(_REPO / 'tests' / 'support')]
     from swivel_car_testing import next_domain_id, spin_until
-from swivel_car_stack import lockstep_parameters, NodeProcess, start_node
+from swivel_car_stack import lockstep_parameters, NodeProcess, process_report, start_node
 
 CLIMB_WALL_LIMIT = 600.0  # [s] guard against a hung stack, not a measurement
 # [s] wall; half of it the controller waits for the planner. A loaded CI machine held a
 # node up for seconds: within it, the climb stays deterministic.
 LOCKSTEP_TIMEOUT = 6.0
 RESEND_AFTER = 5.0  # [s] wall
-REPORT_CHARS = 1500  # [1] of each process' output in a timeout's report
 
 
 class SimSession:
@@ -144,13 +145,7 @@ class SimSession:
             spin_until(self.executor, condition, timeout, what)
         except TimeoutError as error:
             # What each node said is the only trace of why a load-dependent wait ran out.
-            raise TimeoutError(f'{error}\n{self.report()}') from None
-
-    def report(self) -> str:
-        """Each process: running or its exit code, and the end of what it printed."""
-        return '\n'.join(
-            f'--- {p.name}: {"running" if p.running() else f"exited {p.process.returncode}"}'
-            f'\n{p.output()[-REPORT_CHARS:]}' for p in self.processes)
+            raise TimeoutError(f'{error}\n{process_report(self.processes)}') from None
 
     def wait_ready(self, timeout: float = 60.0) -> None:
         """
@@ -219,23 +214,24 @@ class SimSession:
         if not response.success:
             raise RuntimeError(f'sim set_paused failed: {response.message}')
 
-    def run(self, steps: int) -> None:
+    def run(self, steps: int) -> TimeMsg:
         """
         Run ``steps`` physics steps (whole control periods) and hold the sim paused there.
 
-        Returns once the controller has answered the state the sim paused at, whatever the
-        machine's speed: where the sim stops does not depend on when this node acts.
+        Returns the stamp of the state it paused at, once the controller has answered it,
+        whatever the machine's speed: where the sim stops does not depend on when this node
+        acts.
         """
         response = self.call(self.run_client, StepSimulation.Request(steps=steps))
         if not response.success:
             raise RuntimeError(f'sim run failed: {response.message}')
-        end = response.sim_time.sec * 1_000_000_000 + response.sim_time.nanosec  # [ns]
+        end = stamp_ns(response.sim_time)  # [ns]
 
         def answered() -> bool:
-            stamp = self.controller_state.header.stamp
-            return stamp.sec * 1_000_000_000 + stamp.nanosec >= end
+            return stamp_ns(self.controller_state.header.stamp) >= end
 
         self.spin_until(answered, 60.0, f'the sim to run until {end * 1e-9:.3f} s')
+        return response.sim_time
 
     def settle(self, seconds: float) -> None:
         """Let ``seconds`` of sim time pass while spinning (the sim keeps stepping)."""

@@ -18,12 +18,12 @@ from typing import Any, IO
 
 from std_srvs.srv import SetBool
 from swivel_car_stack import (
-    config_path, executable_path, INSTALL_DIR, lockstep_parameters, NodeProcess, REPO_ROOT,
-    ros_environment, spin_until, start_node)
+    config_path, executable_path, INSTALL_DIR, lockstep_parameters, NodeProcess,
+    process_report, REPO_ROOT, ros_environment, spin_until, start_node)
 
 __all__ = ['config_path', 'executable_path', 'INSTALL_DIR', 'lockstep_parameters',
-           'next_domain_id', 'NodeProcess', 'remove_unborn_shm_ports', 'REPO_ROOT',
-           'resume_sim', 'ros_environment', 'spin_until', 'start_node']
+           'next_domain_id', 'NodeProcess', 'process_report', 'remove_unborn_shm_ports',
+           'REPO_ROOT', 'resume_sim', 'ros_environment', 'spin_until', 'start_node']
 
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
 # stragglers are never heard. Every process (a pytest-xdist worker, another pytest, the
