@@ -244,6 +244,9 @@ def test_run_advances_whole_periods_and_pauses_at_the_state_they_end_in(harness_
     assert h.sim.sim.steps == 25  # paused there
     refused = h.call(StepSimulation, 'run', StepSimulation.Request(steps=0))
     assert not refused.success and 'steps must be in [1, 100000]' in refused.message
+    for _ in range(20):
+        h.executor.spin_once(timeout_sec=0.01)
+    assert h.sim.sim.steps == 25 and h.sim._lockstep.paused  # the refusal changed nothing
     assert h.call(StepSimulation, 'run', StepSimulation.Request(steps=100_000)).success
     assert h.call(SetBool, 'set_paused', SetBool.Request(data=True)).success  # ends it early
     steps = h.sim.sim.steps
