@@ -175,6 +175,8 @@ class PlannerNode(Node):
         self._plans = _PlanWorker(self)
         # topic -> (sim time [s], steady clock [s]) of its last message
         self._received: dict[str, tuple[float, float]] = {}
+        self._clock_last = -math.inf  # [s] the node clock at the last input heard
+        self._clock_moved_wall = -math.inf  # [s] steady clock when an input last saw it move
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
         self._last_tick = 0.0  # [s] node clock when the running climb last had a tick
         self._last_tick_wall = 0.0  # [s] steady clock then
@@ -294,8 +296,15 @@ class PlannerNode(Node):
         A climb starts from the inputs heard after its planning (``_planned``), so none is
         kept before.
         """
-        self._received[topic] = (self._now(), time.monotonic())
+        now, wall = self._now(), time.monotonic()
+        self._received[topic] = (now, wall)
+        if now != self._clock_last:
+            self._clock_last, self._clock_moved_wall = now, wall
         return self._climb is not None
+
+    def _clock_stands(self) -> bool:
+        """Tell whether the inputs have seen the node clock stand still for ready_timeout."""
+        return time.monotonic() - self._clock_moved_wall > self._ready_timeout
 
     def _add(self, topic: str, stamp: TimeMsg, value: tuple) -> None:
         for tick in self._sync.add(topic, stamp_to_seconds(stamp), value):
@@ -312,14 +321,17 @@ class PlannerNode(Node):
         after it, from their queues, which look a second old in sim time though they came
         milliseconds ago (seen on a loaded machine: the clock leapt 1.15 s ahead of them in
         0.13 s of wall time, and a request then was refused on a running stack). An input that
-        has stopped is silent on both clocks.
+        has stopped is silent on both clocks. A clock that stands still (a sim gone, or one
+        restarted but unheard) keeps every input fresh in sim time: then wall time alone tells.
         """
         now, wall = self._now(), time.monotonic()
         timeout = self._ready_timeout
+        clock_stands = self._clock_stands()
 
         def silent(topic: str) -> bool:
             sim, steady = self._received[topic]
-            return now - sim > timeout and (not wall_too or wall - steady > timeout)
+            return (now - sim > timeout or clock_stands) and \
+                (not wall_too or wall - steady > timeout)
 
         return [topic for topic in _INPUTS
                 if now <= 0.0 or topic not in self._received or silent(topic)]
@@ -336,9 +348,11 @@ class PlannerNode(Node):
         if not request.plan_only:
             missing = self._missing_inputs(wall_too=True)
             if missing:
+                stands = f' (sim time has stood at {self._now():.2f} s)' \
+                    if self._clock_stands() else ''
                 answer(self._failure(ErrorCode.NOT_READY,
-                                     f'no recent message on {", ".join(missing)}: are the sim, '
-                                     f'controller and odometry running?'))
+                                     f'no recent message on {", ".join(missing)}{stands}: are '
+                                     f'the sim, controller and odometry running?'))
                 return
             if self._busy():
                 answer(self._failure(ErrorCode.BUSY,

@@ -236,6 +236,26 @@ def test_a_clock_ahead_of_the_queued_inputs_is_ready_a_silent_input_is_not(rig):
     assert rig.command is None
 
 
+def test_a_clock_standing_still_keeps_no_silent_input_fresh(rig):
+    """
+    Check a silent input counts as gone on wall time alone while the clock stands still.
+
+    Seen on a stack: the planner never heard a restarted sim (a middleware defect, see
+    tests/test_stack.py), so its clock stood at the old sim's last moment and the old sim's
+    last imu looked fresh in sim time; a climb was accepted and aborted a second later.
+    """
+    rig.warm_up()
+    start = time.monotonic()
+    while time.monotonic() < start + 1.2:  # [s] more than ready_timeout
+        rig.publish_state(inputs=('odom', 'controller'))  # the same moment: /clock stands
+        rig.executor.spin_once(timeout_sec=0.005)
+    response = result_of(rig, rig.call(step_height=0.5, step_distance=1.0))
+    assert response.error_code == ErrorCode.NOT_READY
+    assert response.message.startswith('no recent message on imu (sim time has stood at '), \
+        response.message
+    assert rig.command is None
+
+
 def test_plan_only_returns_the_plan_without_moving(rig):
     response = result_of(rig, rig.call(**SUCCESSFUL_CLIMB, plan_only=True))
     assert response.success, response.message
