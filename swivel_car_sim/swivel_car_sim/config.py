@@ -37,11 +37,11 @@ PARAMETERS: dict[str, tuple[object, str]] = {
     'initial_y': (0.0, '[m] initial base_link y in the world'),
     'initial_yaw': (0.0, '[rad] initial heading'),
     'start_paused': (False, 'start with the physics paused (~/set_paused false resumes)'),
-    'clock_rate': (100.0, '[Hz] /clock publish rate (sim time); control_period divided by a '
-                          'whole number. Each node with use_sim_time takes every message '
-                          '(about 55 us here): at 10 Hz, as gazebo_ros publishes, the '
-                          'lockstep chain takes 14 % less CPU; sim-time clocks then move in '
-                          '0.1 s steps'),
+    'clock_rate': (10.0, '[Hz] /clock publish rate (sim time); control_period divided by a '
+                         'whole number. 10 Hz, as gazebo_ros publishes: each node with '
+                         'use_sim_time takes every message (about 55 us here), and at 100 Hz '
+                         'the lockstep chain takes 14 % more CPU; sim-time clocks move in '
+                         'steps of 1/clock_rate'),
     'imu_rate': (100.0, '[Hz] imu publish rate; control_period divided by a whole number'),
     'ground_truth_rate': (100.0, '[Hz] ground_truth/odom publish rate; as imu_rate'),
     'ground_friction': (1.0, '[1] friction coefficient of the ground'),

@@ -18,17 +18,18 @@ def test_defaults_give_the_architecture_timing():
     assert cfg.physics.time_step == 0.002
     assert cfg.control_period == 0.01
     assert cfg.steps_per_period == 5
-    assert cfg.clock_every == cfg.imu_every == cfg.ground_truth_every == 1
+    assert cfg.imu_every == cfg.ground_truth_every == 1
+    assert cfg.clock_every == 10  # 10 Hz, as gazebo_ros publishes /clock
     assert not cfg.lockstep
     assert cfg.physics.description == CarDescription()
 
 
 def test_rates_and_geometry_overrides():
     cfg = SimNodeConfig.from_values({'ground_truth_rate': 20.0, 'imu_rate': 50.0,
-                                     'clock_rate': 10.0,
+                                     'clock_rate': 50.0,
                                      'phi': -0.5, 'body_mass': 10, 'time_step': 0.001,
                                      'rear_differential': 'locked'})
-    assert cfg.ground_truth_every == 5 and cfg.imu_every == 2 and cfg.clock_every == 10
+    assert cfg.ground_truth_every == 5 and cfg.imu_every == 2 and cfg.clock_every == 2
     assert cfg.steps_per_period == 10
     assert cfg.physics.description.phi == -0.5
     assert cfg.physics.description.body_mass == 10.0
