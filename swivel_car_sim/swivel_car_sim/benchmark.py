@@ -6,8 +6,9 @@ Prints, from one run on this machine:
 1. raw pybullet stepping of the same world and URDF (stepSimulation only);
 2. the physics core, SwivelCarSim.step (drive train torques and the watchdog every step);
 3. the sim node spun in this process on an EventsExecutor (as run_node spins it) with
-   real_time_factor 0, publishing /clock, joint_states, imu and ground_truth/odom every
-   control period, first with no subscriber, then to a subscriber of each in another process
+   real_time_factor 0, publishing joint_states, imu and ground_truth/odom every control
+   period and /clock at its default rate (10 Hz of sim time), first with no subscriber,
+   then to a subscriber of each in another process
    that takes them as the stack's nodes do (serialized, on an EventsExecutor; a
    SingleThreadedExecutor subscriber of deserialized messages fell behind at 2000 messages/s,
    and the publisher then also paid for reliable-QoS repairs: +254-258 % against +186-208 %
