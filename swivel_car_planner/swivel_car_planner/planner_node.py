@@ -348,11 +348,11 @@ class PlannerNode(Node):
         if not request.plan_only:
             missing = self._missing_inputs(wall_too=True)
             if missing:
-                stands = f' (sim time has stood at {self._now():.2f} s)' \
-                    if self._clock_stands() else ''
+                question = (f'sim time has stood at {self._now():.2f} s: is the sim running, '
+                            f'not paused?' if self._clock_stands() else
+                            'are the sim, controller and odometry running?')
                 answer(self._failure(ErrorCode.NOT_READY,
-                                     f'no recent message on {", ".join(missing)}{stands}: are '
-                                     f'the sim, controller and odometry running?'))
+                                     f'no recent message on {", ".join(missing)}: {question}'))
                 return
             if self._busy():
                 answer(self._failure(ErrorCode.BUSY,

@@ -251,7 +251,7 @@ def test_a_clock_standing_still_keeps_no_silent_input_fresh(rig):
         rig.executor.spin_once(timeout_sec=0.005)
     response = result_of(rig, rig.call(step_height=0.5, step_distance=1.0))
     assert response.error_code == ErrorCode.NOT_READY
-    assert response.message.startswith('no recent message on imu (sim time has stood at '), \
+    assert response.message.startswith('no recent message on imu: sim time has stood at '), \
         response.message
     assert rig.command is None
 
