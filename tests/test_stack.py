@@ -77,7 +77,7 @@ BRAKING = 0.3  # [s]
 # heard the controller. A node not heard within this long of wall time after its start, a
 # new sim that hears no controller, or a planner deaf to the stack this long, is started
 # once more: a new process joins afresh.
-REJOIN_AFTER = 20.0  # [s]
+REJOIN_AFTER = 10.0  # [s]
 # What a sim says when no actuator_command came within lockstep_timeout (sim_node.py).
 NO_COMMAND = 'lockstep: no actuator_command'
 
