@@ -41,6 +41,7 @@ from swivel_car_msgs.srv import ClimbStep, StepSimulation
 from swivel_car_planner.core import ClimbRequest, ErrorCode
 from swivel_car_ros.serialized import read_header
 from swivel_car_sim.config import SimNodeConfig
+from swivel_car_sim.sim_node import LOCKSTEP_TIMED_OUT_LOG
 
 HEIGHT = 0.04  # [m]
 DISTANCE = 1.0  # [m] front axle to the edge; nearer, the planner has no room to align
@@ -208,7 +209,7 @@ def test_a_ros_lockstep_climb_is_the_in_process_climb(ros_run):
     ros, first_tick, recorder, logs = ros_run
     # The chain must have held: no node went on without the command it waits for.
     late = [line for text in logs.values() for line in text.splitlines()
-            if 'lockstep_wait' in line or 'lockstep: no actuator_command' in line]
+            if 'lockstep_wait' in line or LOCKSTEP_TIMED_OUT_LOG in line]
     assert not late, late
     assert ros.success, f'{ros.error_code}: {ros.message}'
 

@@ -47,6 +47,7 @@ from swivel_car_model.params import SwivelCarParams
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
 from swivel_car_ros.ros_params import moment_seconds, stamp_to_seconds
+from swivel_car_sim.sim_node import LOCKSTEP_RESUMED_LOG, LOCKSTEP_TIMED_OUT_LOG
 from swivel_car_testing import (
     lockstep_parameters, next_domain_id, NodeProcess, process_report, resume_sim, spin_until,
     start_node)
@@ -78,8 +79,6 @@ BRAKING = 0.3  # [s]
 # new sim that hears no controller, or a planner deaf to the stack this long, is started
 # once more: a new process joins afresh.
 REJOIN_AFTER = 10.0  # [s]
-# What a sim says when no actuator_command came within lockstep_timeout (sim_node.py).
-NO_COMMAND = 'lockstep: no actuator_command'
 
 
 def time_msg(t: float) -> Time:
@@ -208,6 +207,8 @@ class Stack:
         With ``heard``: wait until ``heard()`` shows this node hears it (``what``), starting
         it once more if Fast DDS left them unmatched (``REJOIN_AFTER``).
         """
+        sim = self.processes.get('sim')
+        answered_again = sim.output().count(LOCKSTEP_RESUMED_LOG) if sim else 0
         self.processes[name] = self.start(name)
         if name == 'odometry':
             self.odom_time = None  # until the new one publishes
@@ -220,8 +221,25 @@ class Stack:
             self.spin_until(heard, 60.0, what)
             return
         if name == 'sim' and not self._sim_hears_the_controller():
-            self.rejoin(name, f'the new sim said "{NO_COMMAND}"')
+            self.rejoin(name, f'the new sim said "{LOCKSTEP_TIMED_OUT_LOG}"')
             self.spin_until(heard, 60.0, what)
+        if name == 'controller' and not self._sim_hears_again(answered_again):
+            self.rejoin(name, f'the sim did not say "{LOCKSTEP_RESUMED_LOG}" in {REJOIN_AFTER} s')
+            self.spin_until(heard, 60.0, what)
+
+    def _sim_hears_again(self, count: int) -> bool:
+        """
+        Tell whether the sim, timed out on a killed controller, hears a new one.
+
+        It says so once more than ``count`` times.
+        """
+        sim = self.processes['sim']
+        try:
+            self.spin_until(lambda: sim.output().count(LOCKSTEP_RESUMED_LOG) > count, REJOIN_AFTER,
+                            'the sim to hear the new controller')
+        except TimeoutError:
+            return False
+        return True
 
     def _sim_hears_the_controller(self) -> bool:
         """
@@ -230,9 +248,10 @@ class Stack:
         One that does not waits lockstep_timeout on its first state, and says so.
         """
         sim, start = self.processes['sim'], self.sim_time()
-        self.spin_until(lambda: self.sim_time() >= start + 1.0 or NO_COMMAND in sim.output(),
-                        60.0, 'the new sim to run on')
-        return NO_COMMAND not in sim.output()
+        self.spin_until(
+            lambda: self.sim_time() >= start + 1.0 or LOCKSTEP_TIMED_OUT_LOG in sim.output(),
+            60.0, 'the new sim to run on')
+        return LOCKSTEP_TIMED_OUT_LOG not in sim.output()
 
     def rejoin(self, name: str, why: str) -> None:
         """Kill node ``name`` and start it once more (``REJOIN_AFTER``), with a warning."""

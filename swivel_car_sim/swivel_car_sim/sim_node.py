@@ -32,6 +32,10 @@ from swivel_car_sim.world import StepSpec
 # With real_time_factor 0 one timer callback steps for at most this long, then yields to
 # the executor so that commands and service calls are never starved.
 FAST_BATCH_WALL_TIME = 0.005  # [s]
+# How the log says that the controller stopped answering, and that it answers again: a
+# supervisor (or a test) reads them to tell whether the sim hears the controller.
+LOCKSTEP_TIMED_OUT_LOG = 'lockstep: no actuator_command'
+LOCKSTEP_RESUMED_LOG = 'lockstep: actuator_command again'
 
 
 class SimNode(Node):
@@ -120,7 +124,7 @@ class SimNode(Node):
         tick = self._lockstep.tick(time.monotonic_ns())
         if tick.timed_out:
             self.get_logger().warn(
-                f'lockstep: no actuator_command for {self.config.lockstep_timeout} s: advancing '
+                f'{LOCKSTEP_TIMED_OUT_LOG} for {self.config.lockstep_timeout} s: advancing '
                 'at real time without one until one comes', throttle_duration_sec=5.0)
         for _ in range(tick.periods):
             self._advance()
@@ -166,7 +170,13 @@ class SimNode(Node):
             self.get_logger().warn(f'ignoring actuator_command: {error}',
                                    throttle_duration_sec=1.0)
             return
-        if self.config.lockstep and self._lockstep.heard(computed, time.monotonic_ns()):
+        if not self.config.lockstep:
+            return
+        timed_out = self._lockstep.unanswered
+        advance = self._lockstep.heard(computed, time.monotonic_ns())
+        if timed_out:
+            self.get_logger().info(f'{LOCKSTEP_RESUMED_LOG}: waiting for it every period again')
+        if advance:
             self._advance()
 
     def _stale(self, computed: int) -> bool:

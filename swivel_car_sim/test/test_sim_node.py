@@ -17,7 +17,7 @@ from std_msgs.msg import Header
 from std_srvs.srv import SetBool
 from swivel_car_msgs.msg import ActuatorCommand, StepObstacle
 from swivel_car_msgs.srv import RemoveObstacle, ResetSimulation, SpawnObstacle, StepSimulation
-from swivel_car_sim.sim_node import SimNode
+from swivel_car_sim.sim_node import LOCKSTEP_RESUMED_LOG, LOCKSTEP_TIMED_OUT_LOG, SimNode
 from swivel_car_testing import next_domain_id, spin_until
 
 TIMEOUT = 20.0  # [s] wall guard against a hang, not a measurement
@@ -339,7 +339,7 @@ def test_lockstep_timeout_advances_and_the_watchdog_stops_the_drive(harness_fact
 
 
 def test_after_a_lockstep_timeout_the_sim_runs_at_real_time_until_a_command_comes(
-        harness_factory):
+        harness_factory, capfd):
     # Before, it advanced one period per lockstep_timeout: with a killed controller, 1 s of
     # sim time took 100 timeouts.
     h = harness_factory(lockstep=True, lockstep_timeout=1.0)
@@ -354,6 +354,8 @@ def test_after_a_lockstep_timeout_the_sim_runs_at_real_time_until_a_command_come
             h.executor.spin_once(timeout_sec=0.01)
         states.append(_ns(h.joint_states[-1].header.stamp))
     assert states[0] == states[1]
+    log = capfd.readouterr().err
+    assert log.index(LOCKSTEP_TIMED_OUT_LOG) < log.index(LOCKSTEP_RESUMED_LOG), log
 
 
 @pytest.mark.parametrize('name, value, message', [
