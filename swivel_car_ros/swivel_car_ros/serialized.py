@@ -61,11 +61,12 @@ def read_logged(logger, read: Callable[[bytes], T], data: bytes, topic: str) -> 
     """
     Return ``read(data)``, or None once ``logger`` has said why the message is ignored.
 
-    ``topic`` names the message in the log line (at most one every 5 s).
+    ``topic`` names the message in the log line (at most one every 5 s). A message shorter
+    than its fields (``struct.error`` from any reader) is refused as a malformed one is.
     """
     try:
         return read(data)
-    except ValueError as error:
+    except (ValueError, struct.error) as error:
         logger.error(f'{topic} ignored: {error}', throttle_duration_sec=5.0)
         return None
 

@@ -7,7 +7,7 @@ from rclpy.serialization import deserialize_message, serialize_message
 from sensor_msgs.msg import JointState
 from swivel_car_msgs.msg import ActuatorCommand
 from swivel_car_ros.serialized import (
-    read_joint_state, read_logged, SerializedMessage, STAMP_FORMAT)
+    read_header, read_joint_state, read_logged, SerializedMessage, STAMP_FORMAT)
 
 _NAMES = st.text(st.characters(codec='utf-8', exclude_characters='\x00'), max_size=9)
 _VALUES = st.lists(st.floats(allow_nan=False), max_size=6)
@@ -54,6 +54,9 @@ def test_a_message_read_in_error_is_logged_and_ignored():
     assert read_logged(Logger(), read_joint_state, big_endian, 'joint_states') is None
     assert lines == [
         ('joint_states ignored: not little-endian plain CDR: encapsulation 0000', 5.0)]
+    # A reader of a few fields at their offsets, on a message cut before them.
+    assert read_logged(Logger(), read_header, data[:8], 'odom') is None
+    assert lines[1][0].startswith('odom ignored: unpack_from requires a buffer'), lines
 
 
 def test_a_rewritten_message_is_the_message_built_field_by_field():
