@@ -17,7 +17,6 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Empty
-from swivel_car_control.conversions import set_yaw
 from swivel_car_control.core.joint_states import (
     JointStateOdometry, yaw_quaternion, YAW_RATE_SOURCES)
 from swivel_car_control.core.odometry_input import (
@@ -193,17 +192,19 @@ class OdometryNode(Node):
     def _publish(self, stamp) -> None:
         odometry = self._odometry
         msg = self._odom
+        orientation = yaw_quaternion(odometry.yaw)
         msg.pack(0, stamp.sec, stamp.nanosec)
-        msg.pack(1, odometry.x, odometry.y, 0.0, *yaw_quaternion(odometry.yaw))
+        msg.pack(1, odometry.x, odometry.y, 0.0, *orientation)
         msg.pack(3, odometry.v, 0.0, 0.0, 0.0, 0.0, odometry.omega)
         self._odom_pub.publish(msg.serialized())
         if self._tf is not None:
-            transform = self._transform
-            transform.header.stamp = stamp
-            transform.transform.translation.x = odometry.x
-            transform.transform.translation.y = odometry.y
-            set_yaw(transform.transform.rotation, odometry.yaw)
-            self._tf.sendTransform(transform)
+            transform = self._transform.transform
+            self._transform.header.stamp = stamp
+            transform.translation.x = odometry.x
+            transform.translation.y = odometry.y
+            rotation = transform.rotation
+            rotation.x, rotation.y, rotation.z, rotation.w = orientation
+            self._tf.sendTransform(self._transform)
 
     def _on_reset(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
         self._odometry.reset()
