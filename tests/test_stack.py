@@ -207,8 +207,7 @@ class Stack:
         With ``heard``: wait until ``heard()`` shows this node hears it (``what``), starting
         it once more if Fast DDS left them unmatched (``REJOIN_AFTER``).
         """
-        sim = self.processes.get('sim')
-        answered_again = sim.output().count(LOCKSTEP_RESUMED_LOG) if sim else 0
+        resumed = self._sim_resumed() if heard is not None and name == 'controller' else 0
         self.processes[name] = self.start(name)
         if name == 'odometry':
             self.odom_time = None  # until the new one publishes
@@ -217,41 +216,41 @@ class Stack:
         try:
             self.spin_until(heard, REJOIN_AFTER, what)
         except TimeoutError:
-            self.rejoin(name, f'{what} not heard in {REJOIN_AFTER} s')
-            self.spin_until(heard, 60.0, what)
-            return
-        if name == 'sim' and not self._sim_hears_the_controller():
-            self.rejoin(name, f'the new sim said "{LOCKSTEP_TIMED_OUT_LOG}"')
-            self.spin_until(heard, 60.0, what)
-        if name == 'controller' and not self._sim_hears_again(answered_again):
-            self.rejoin(name, f'the sim did not say "{LOCKSTEP_RESUMED_LOG}" in {REJOIN_AFTER} s')
+            why = f'{what} not heard in {REJOIN_AFTER} s'
+        else:
+            why = self._sim_unmatched(name, resumed)
+        if why is not None:
+            self.rejoin(name, why)
             self.spin_until(heard, 60.0, what)
 
-    def _sim_hears_again(self, count: int) -> bool:
+    def _sim_resumed(self) -> int:
+        """Return how often the sim has said a controller answers it again."""
+        return self.processes['sim'].output().count(LOCKSTEP_RESUMED_LOG)
+
+    def _sim_unmatched(self, name: str, resumed: int) -> str | None:
         """
-        Tell whether the sim, timed out on a killed controller, hears a new one.
+        Tell why the sim and node ``name``, just started and heard here, are unmatched.
 
-        It says so once more than ``count`` times.
+        None: they are matched, or it is neither the sim nor the controller. A new sim that
+        does not hear the controller waits lockstep_timeout on its first state and says so;
+        one that hears it runs on in lockstep. The sim, timed out on a killed controller,
+        says when a new one answers it (once more than ``resumed`` times).
         """
         sim = self.processes['sim']
-        try:
-            self.spin_until(lambda: sim.output().count(LOCKSTEP_RESUMED_LOG) > count, REJOIN_AFTER,
-                            'the sim to hear the new controller')
-        except TimeoutError:
-            return False
-        return True
-
-    def _sim_hears_the_controller(self) -> bool:
-        """
-        Tell whether a sim just started hears the controller: its time runs on in lockstep.
-
-        One that does not waits lockstep_timeout on its first state, and says so.
-        """
-        sim, start = self.processes['sim'], self.sim_time()
-        self.spin_until(
-            lambda: self.sim_time() >= start + 1.0 or LOCKSTEP_TIMED_OUT_LOG in sim.output(),
-            60.0, 'the new sim to run on')
-        return LOCKSTEP_TIMED_OUT_LOG not in sim.output()
+        if name == 'sim':
+            start = self.sim_time()
+            self.spin_until(
+                lambda: self.sim_time() >= start + 1.0 or LOCKSTEP_TIMED_OUT_LOG in sim.output(),
+                60.0, 'the new sim to run on')
+            if LOCKSTEP_TIMED_OUT_LOG in sim.output():
+                return f'the new sim said "{LOCKSTEP_TIMED_OUT_LOG}"'
+        if name == 'controller':
+            try:
+                self.spin_until(lambda: self._sim_resumed() > resumed, REJOIN_AFTER,
+                                'the sim to hear the new controller')
+            except TimeoutError:
+                return f'the sim did not say "{LOCKSTEP_RESUMED_LOG}" in {REJOIN_AFTER} s'
+        return None
 
     def rejoin(self, name: str, why: str) -> None:
         """Kill node ``name`` and start it once more (``REJOIN_AFTER``), with a warning."""
