@@ -140,6 +140,9 @@ class OdometryNode(Node):
                                  STATE_QUEUE_DEPTH, raw=True)
         self.create_service(Empty, '~/reset', self._on_reset)
         self.create_service(SetPose2D, '~/set_pose', self._on_set_pose)
+        self.get_logger().info(
+            f'odometry up: {odom.header.frame_id} -> {odom.child_frame_id}, yaw rate from '
+            f'{config.yaw_rate_source}, at most {config.publish_rate:g} Hz')
 
     def _live_config(self, changes: dict[str, Any]) -> OdometryConfig:
         try:
