@@ -60,8 +60,11 @@ NODES = {'sim': ('swivel_car_sim', 'sim_node'),
 UP_LOGS = {'controller': 'controller up', 'odometry': 'odometry up', 'planner': 'planner ready'}
 # After this many wall seconds without a command the sim takes the controller for gone and
 # runs on at real time with its watchdog (a killed controller); the controller waits half
-# of it for the planner and this test's driver, generous for a loaded machine.
-LOCKSTEP_TIMEOUT = 3.0  # [s]
+# of it for the planner and this test's driver. At 3 s, a full `make test` once held this
+# node up longer than the 1.5 s wait: the controller went on without the driver, took its
+# release 0.36 s of sim time late, and the car stopped that much later than the deadman
+# test allows (1.19 s against 0.9; 0.83 s whenever the chain holds, every time).
+LOCKSTEP_TIMEOUT = 6.0  # [s], as sim_session.py
 # Messages the test keeps per topic: 10 s of sim time, so an unpaced sim that runs ahead of
 # the test's node (nothing holds it while no one drives) loses none of them on the way.
 QUEUE = 1000
@@ -215,10 +218,16 @@ class Stack:
         pause = name in UP_LOGS and 'sim' in self.processes
         if pause:
             self.pause_sim(True)
-        self.processes[name] = self.start(name)
+        self.processes[name] = self.start(name, paused=name == 'sim')
         if pause:
             self.processes[name].wait_for_output(UP_LOGS[name], 60.0)
             self.pause_sim(False)
+        if name == 'sim':
+            # A new sim runs only once this node can hear it: one that ran while this node
+            # was still discovering it (2-3 s of wall time) was past the stamps it is told
+            # apart from the old one by (22 s of sim time, once).
+            truth = len(self.truth)
+            heard = self._resuming(heard or (lambda: len(self.truth) > truth))
         if name == 'odometry':
             self.odom_time = None  # until the new one publishes
         if heard is None:
@@ -232,6 +241,25 @@ class Stack:
         if why is not None:
             self.rejoin(name, why)
             self.spin_until(heard, 60.0, what)
+
+    def _resuming(self, heard: Callable[[], bool]) -> Callable[[], bool]:
+        """
+        Return ``heard``, which asks the sim to resume, again every second, until it is true.
+
+        A server that has not yet matched this node's client drops the request unanswered;
+        asked again, a sim running already runs on.
+        """
+        asked = -math.inf  # [s] wall
+
+        def resumed_and_heard() -> bool:
+            nonlocal asked
+            if heard():
+                return True
+            if time.monotonic() - asked > 1.0:
+                self.set_paused.call_async(SetBool.Request(data=False))
+                asked = time.monotonic()
+            return False
+        return resumed_and_heard
 
     def pause_sim(self, paused: bool) -> None:
         response = self.call(self.set_paused, SetBool.Request(data=paused), 'sim/set_paused')
