@@ -79,10 +79,10 @@ BRAKING = 0.3  # [s]
 # heard it 25 s later, though its graph listed the new sim's publishers (stopping the sim
 # gracefully, 1 of 17, or keeping its old ports from reuse, 4 of 44, did not help), while 60
 # first starts in fresh domains were all heard; eProsima/Fast-DDS#3822 reports the same of
-# late joiners. In CI runs a new sim was once never heard by this test's node, once never
-# heard the controller. A node not heard within this long of wall time after its start, a
-# new sim that hears no controller, or a planner deaf to the stack this long, is started
-# once more: a new process joins afresh.
+# late joiners. In CI runs a new sim was once never heard by this test's node (perhaps the race
+# a paused start now avoids, see restart), once never heard the controller. A node not heard
+# within this long of wall time after its start, a new sim that hears no controller, or a
+# planner deaf to the stack this long, is started once more: a new process joins afresh.
 REJOIN_AFTER = 10.0  # [s]
 
 
