@@ -210,7 +210,8 @@ class Stack:
         Start node ``name`` again, as the launch files' respawn does.
 
         With ``heard``: wait until ``heard()`` shows this node hears it (``what``), starting
-        it once more if Fast DDS left them unmatched (``REJOIN_AFTER``).
+        it once more if Fast DDS left them unmatched (``REJOIN_AFTER``). The sim waits paused
+        while another node boots; a new sim starts paused and runs once this node hears it.
         """
         resumed = self._sim_resumed() if heard is not None and name == 'controller' else 0
         # While a node boots (1-2.5 s of wall time) the chain would run flat out for nobody:
@@ -222,14 +223,18 @@ class Stack:
         if pause:
             self.processes[name].wait_for_output(UP_LOGS[name], 60.0)
             self.pause_sim(False)
+        if name == 'odometry':
+            self.odom_time = None  # until the new one publishes
         if name == 'sim':
             # A new sim runs only once this node can hear it: one that ran while this node
             # was still discovering it (2-3 s of wall time) was past the stamps it is told
             # apart from the old one by (22 s of sim time, once).
-            truth = len(self.truth)
-            heard = self._resuming(heard or (lambda: len(self.truth) > truth))
-        if name == 'odometry':
-            self.odom_time = None  # until the new one publishes
+            if heard is None:
+                truth = len(self.truth)
+                self.spin_until(self._resuming(lambda: len(self.truth) > truth), 60.0,
+                                'the new sim')
+                return
+            heard = self._resuming(heard)
         if heard is None:
             return
         try:
