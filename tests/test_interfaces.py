@@ -17,7 +17,7 @@ from swivel_car_msgs import action, msg, srv
 from swivel_car_testing import spin_until
 
 MESSAGE_TYPES = [msg.ActuatorCommand, msg.SwivelCommand, msg.SwivelControllerState,
-                 msg.StepObstacle, msg.ClimbPlan, msg.ClimbOutcome]
+                 msg.StepObstacle, msg.ClimbPlan, msg.ClimbOutcome, msg.DetectedStep]
 SERVICE_TYPES = [srv.ClimbStep, srv.SpawnObstacle, srv.RemoveObstacle, srv.ResetSimulation,
                  srv.StepSimulation, srv.SetPose2D]
 
@@ -114,7 +114,7 @@ def test_climb_step_action_goal_feedback_result(node_and_executor):
 def test_interface_constants_are_distinct():
     codes = [value for name, value in vars(srv.ClimbStep.Response).items()
              if name.startswith('ERROR_')]
-    assert len(codes) == len(set(codes)) == 14
+    assert len(codes) == len(set(codes)) == 15
     phases = [value for name, value in vars(action.ClimbStep.Feedback).items()
               if name.startswith('PHASE_')]
     assert len(phases) == len(set(phases))

@@ -23,6 +23,7 @@ class ErrorCode(IntEnum):
     STALL = 11
     NO_PROGRESS = 12
     FAILED = 13
+    NO_STEP_DETECTED = 14
 
 
 class Phase(IntEnum):
