@@ -80,7 +80,7 @@ def test_the_approach_reaches_the_lift_point_aligned_despite_the_swivels_yaw():
     # steered on the bare heading, the approach overshot by 0.25 rad in the sim.
     machine, plan, car = start()
     run_until(machine, car, lambda m, c: m.step == Step.PRESS)
-    heading = machine._edge.relative_heading(car.odometry.yaw)
+    heading = machine.climb.edge.relative_heading(car.odometry.yaw)
     assert heading == pytest.approx(plan.approach_heading, abs=CONFIG.align_tolerance)
 
 
@@ -96,7 +96,7 @@ def test_an_approach_far_off_its_line_turns_in_early_enough_to_lift_aligned():
     machine = ClimbStateMachine(P, CONFIG, plan, 2.4, 0.0)
     run_until(machine, car, lambda m, c: m.step == Step.PRESS)
     assert machine.outcome is None, machine.outcome.message
-    heading = machine._edge.relative_heading(car.odometry.yaw)
+    heading = machine.climb.edge.relative_heading(car.odometry.yaw)
     assert heading == pytest.approx(plan.approach_heading, abs=CONFIG.align_tolerance)
 
 
@@ -105,7 +105,7 @@ def test_the_lift_point_accepts_a_more_oblique_heading_only(more_oblique, lifts)
     # More oblique moves the steering wheel further off the riser (the minimum approach
     # angle is a lower bound); less oblique would put it on the riser.
     machine, plan, car = start()
-    run_until(machine, car, lambda m, c: m._edge is not None and m._lifted_wheel_distance(
+    run_until(machine, car, lambda m, c: m.climb is not None and m.climb.lifted_wheel_distance(
         c.observe()) >= -plan.lead_distance - 0.05)
     assert machine.step == Step.APPROACH
     # The IMU's heading, which the check reads, turned past or short of the plan's.

@@ -13,6 +13,7 @@ import pytest
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_planner.core import (
     ClimbRequest, ClimbStateMachine, Command, ErrorCode, make_plan, Phase, PlannerConfig)
+from swivel_car_planner.core import steps
 from swivel_car_planner.core.geometry import Pose2D, StepEdge
 from swivel_car_planner.core.state_machine import Step
 
@@ -409,3 +410,23 @@ def test_with_the_step_extent_the_approach_reaches_the_planned_crossing(yaw, off
     along = edge.along(car.odometry.x, car.odometry.y) - plan.crossing
     assert abs(-math.sin(heading) * normal + math.cos(heading) * along) < 0.03
     assert machine.phase == Phase.LIFT
+
+
+def test_every_step_but_done_has_its_own_behaviour():
+    machine, plan = start()
+    car = car_before()
+    machine.update(car.observe())
+    for step in Step:
+        if step == Step.DONE:
+            assert step not in steps.BEHAVIOURS
+        else:
+            assert steps.enter(step, machine.climb, car.observe()).step == step
+
+
+def test_a_step_without_a_behaviour_raises_instead_of_running_another(monkeypatch):
+    monkeypatch.delitem(steps.BEHAVIOURS, Step.ADVANCE)
+    machine, plan = start()
+    car = car_before()
+    with pytest.raises(LookupError, match='ADVANCE'):
+        run(machine, car)
+    assert machine.step == Step.LIFT
