@@ -5,6 +5,11 @@ Optionally a recording and a live view (for a full Jazzy install with launch_ros
 
 ros2 launch swivel_car_bringup stack.launch.py [record:=true] [bag:=my_run]
     [foxglove:=true] [foxglove_port:=8765] [gui:=true] [robot_variant:=swivel]
+    [clock_source:=wall] [sensor_profile:=realistic]
+
+clock_source:=wall runs the stack as on the robot: the sim stamps with the system clock and
+publishes no /clock, and every node runs with use_sim_time false; sim (the default) puts
+every node on the sim's /clock.
 """
 
 import os
@@ -14,7 +19,7 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, IncludeLaunchDescription
 from launch.conditions import IfCondition
 from launch.launch_description_sources import PythonLaunchDescriptionSource
-from launch.substitutions import LaunchConfiguration
+from launch.substitutions import LaunchConfiguration, PythonExpression
 from launch_ros.actions import Node
 from launch_ros.parameter_descriptions import ParameterValue
 
@@ -27,12 +32,16 @@ def _include(package: str, launch_file: str, arguments: dict) -> IncludeLaunchDe
 
 
 def generate_launch_description() -> LaunchDescription:
-    use_sim_time = {'use_sim_time': ParameterValue(LaunchConfiguration('use_sim_time'),
-                                                   value_type=bool)}
-    sim_time_argument = {'use_sim_time': LaunchConfiguration('use_sim_time')}
+    # One switch for every node: on the sim's /clock, or all on the system clock.
+    on_sim_time = PythonExpression(["'", LaunchConfiguration('clock_source'), "' != 'wall'"])
+    use_sim_time = {'use_sim_time': ParameterValue(on_sim_time, value_type=bool)}
+    sim_time_argument = {'use_sim_time': on_sim_time}
     return LaunchDescription([
-        DeclareLaunchArgument('use_sim_time', default_value='true',
-                              description='run on the sim clock (/clock)'),
+        DeclareLaunchArgument('clock_source', default_value='sim',
+                              description='sim: every node on the sim /clock; wall: as on the '
+                                          'robot, system clock, use_sim_time false everywhere'),
+        DeclareLaunchArgument('sensor_profile', default_value='ideal',
+                              description='ideal | realistic | a sensor profile YAML path'),
         DeclareLaunchArgument('gui', default_value='false',
                               description='open the pybullet window'),
         DeclareLaunchArgument('robot_variant', default_value='swivel',
@@ -47,7 +56,9 @@ def generate_launch_description() -> LaunchDescription:
                               description='port of the Foxglove WebSocket server'),
         _include('swivel_car_sim', 'sim.launch.py', {
             **sim_time_argument, 'gui': LaunchConfiguration('gui'),
-            'robot_variant': LaunchConfiguration('robot_variant')}),
+            'robot_variant': LaunchConfiguration('robot_variant'),
+            'clock_source': LaunchConfiguration('clock_source'),
+            'sensor_profile': LaunchConfiguration('sensor_profile')}),
         _include('swivel_car_control', 'control.launch.py', sim_time_argument),
         _include('swivel_car_planner', 'planner.launch.py', sim_time_argument),
         Node(package='swivel_car_bringup', executable='robot_description_node',

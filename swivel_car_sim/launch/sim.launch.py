@@ -1,4 +1,9 @@
-"""Start the swivel car sim: ros2 launch swivel_car_sim sim.launch.py [gui:=true] ..."""
+"""
+Start the swivel car sim: ros2 launch swivel_car_sim sim.launch.py [gui:=true] ...
+
+clock_source:=wall use_sim_time:=false runs it as the robot's driver board would (system
+clock, no /clock); sensor_profile:=realistic gives it the hardware's sensors and links.
+"""
 
 import os
 
@@ -24,6 +29,10 @@ def generate_launch_description():
                               description='sim node parameter file'),
         DeclareLaunchArgument('robot_variant', default_value='swivel',
                               description='swivel | car_like'),
+        DeclareLaunchArgument('clock_source', default_value='sim',
+                              description='sim (/clock) | wall (system clock, as the robot)'),
+        DeclareLaunchArgument('sensor_profile', default_value='ideal',
+                              description='ideal | realistic | a sensor profile YAML path'),
     ]
     # Not respawned: a new sim is a new world (the robot at the origin, no obstacles).
     sim = Node(
@@ -38,6 +47,10 @@ def generate_launch_description():
                                                    value_type=float),
                 'robot_variant': ParameterValue(LaunchConfiguration('robot_variant'),
                                                 value_type=str),
+                'clock_source': ParameterValue(LaunchConfiguration('clock_source'),
+                                               value_type=str),
+                'sensor_profile': ParameterValue(LaunchConfiguration('sensor_profile'),
+                                                 value_type=str),
             },
         ])
     return LaunchDescription(arguments + [sim])

@@ -13,6 +13,9 @@ import math
 from swivel_car_model import description
 from swivel_car_model.checks import check_finite_number
 from swivel_car_sim.physics import SimConfig
+from swivel_car_sim.sensor_models import SensorProfile
+
+CLOCK_SOURCES = ('sim', 'wall')
 
 # name -> (default, description). The node declares exactly these: its own, then the robot
 # description's (swivel_car_model.description, shared by every node).
@@ -49,6 +52,14 @@ PARAMETERS: dict[str, tuple[object, str]] = {
                               'phi < 0 robot, whose belly meets step edges)'),
     'world_frame_id': ('world', 'fixed frame of ground_truth/odom and ~/reset_event'),
     'base_frame_id': ('base_link', 'frame of the robot body: imu, ground_truth/odom child'),
+    'clock_source': ('sim', "'sim': stamps of sim time, /clock published; 'wall': as a driver "
+                            'board, stamps from the system clock, no /clock, free running at '
+                            'real time (no lockstep), every other node with use_sim_time false'),
+    'sensor_profile': ('ideal', "'ideal' (the exact state, commands applied as they come), "
+                                "'realistic' (config/sensor_profiles/realistic.yaml: encoders, "
+                                'IMU, latency and losses of named parts) or a profile YAML path'),
+    'sensor_seed': (0, '[1] seed of every draw of the sensor models (lockstep stays '
+                       'deterministic)'),
     **description.PARAMETERS,
 }
 
@@ -78,6 +89,14 @@ class SimNodeConfig:
     ground_truth_every: int  # [1]
     world_frame_id: str
     base_frame_id: str
+    clock_source: str = 'sim'
+    sensors: SensorProfile = SensorProfile('ideal', {}, {})
+    sensor_seed: int = 0
+
+    @property
+    def wall_clock(self) -> bool:
+        """Tell whether the sim stamps with the system clock, as a driver board."""
+        return self.clock_source == 'wall'
 
     @classmethod
     def from_values(cls, values: dict[str, object]) -> 'SimNodeConfig':
@@ -96,6 +115,9 @@ class SimNodeConfig:
             if isinstance(default, bool):
                 if not isinstance(value, bool):
                     raise ValueError(f'{name} must be a bool, got {value!r}')
+            elif isinstance(default, int):
+                if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+                    raise ValueError(f'{name} must be an integer >= 0, got {value!r}')
             elif isinstance(default, float):
                 check_finite_number(name, value)
                 v[name] = float(value)
@@ -104,6 +126,16 @@ class SimNodeConfig:
         for name in ('world_frame_id', 'base_frame_id'):
             if not v[name]:
                 raise ValueError(f'{name} must be a non-empty string')
+        if v['clock_source'] not in CLOCK_SOURCES:
+            raise ValueError(f"clock_source must be 'sim' or 'wall', got {v['clock_source']!r}")
+        if v['clock_source'] == 'wall':
+            if v['lockstep']:
+                raise ValueError('lockstep cannot run with clock_source wall: a driver board '
+                                 'waits for no one (clock_source sim for lockstep)')
+            if v['real_time_factor'] != 1.0:
+                raise ValueError('clock_source wall runs at real time: real_time_factor must '
+                                 f"be 1.0, got {v['real_time_factor']!r}")
+        sensors = SensorProfile.load(v['sensor_profile'])
         robot = description.CarDescription.from_values(
             {name: v[name] for name in description.PARAMETERS})
         physics = SimConfig(
@@ -133,7 +165,9 @@ class SimNodeConfig:
                    start_paused=v['start_paused'], clock_every=every['clock_rate'],
                    imu_every=every['imu_rate'],
                    ground_truth_every=every['ground_truth_rate'],
-                   world_frame_id=v['world_frame_id'], base_frame_id=v['base_frame_id'])
+                   world_frame_id=v['world_frame_id'], base_frame_id=v['base_frame_id'],
+                   clock_source=v['clock_source'], sensors=sensors,
+                   sensor_seed=v['sensor_seed'])
 
 
 def _whole_ratio(numerator: float, denominator: float, name: str, of: str) -> int:

@@ -1,14 +1,18 @@
 """
 The sim node: the pybullet swivel car behind the topics of a motor driver board and an IMU.
 
-It owns /clock and has a deterministic lockstep mode (docs/architecture.md).
+It owns /clock and has a deterministic lockstep mode (docs/architecture.md); with
+``clock_source:=wall`` it stamps with the system clock and runs at real time, as the hardware
+does. Its sensors and links are ``sensor_profile``'s (``swivel_car_sim.sensor_models``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time
 
+from builtin_interfaces.msg import Time
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
@@ -27,6 +31,8 @@ from swivel_car_sim.config import PARAMETERS, SimNodeConfig
 from swivel_car_sim.conversions import (
     actuator_command_fields, sim_time, sim_time_msg, StateMessages)
 from swivel_car_sim.physics import MAX_STEPS_PER_CALL, SwivelCarSim
+from swivel_car_sim.sensor_models import DelayedCommands, SensorSuite
+from swivel_car_sim.wall_clock import MAX_LAG_NS, WallPacer
 from swivel_car_sim.world import StepSpec
 
 # With real_time_factor 0 one timer callback steps for at most this long, then yields to
@@ -63,6 +69,13 @@ class SimNode(Node):
         self._periods = 0
         self._messages = StateMessages(self.sim.joint_names, cfg.world_frame_id,
                                        cfg.base_frame_id)
+        # The hardware's faults: None for the ideal profile (the state as it is, commands
+        # applied as they come).
+        self._sensors = (None if cfg.sensors.ideal
+                         else SensorSuite(cfg.sensors, cfg.sensor_seed, self.sim.state()))
+        self._commands = DelayedCommands(cfg.physics.time_step)
+        self._wall = (WallPacer(round(cfg.control_period * 1e9), 0, time.time_ns())
+                      if cfg.wall_clock else None)
 
         self._clock_pub = self.create_publisher(ClockMsg, '/clock', 10)
         self._joint_pub = self.create_publisher(JointState, 'joint_states', STATE_QUEUE_DEPTH)
@@ -80,7 +93,10 @@ class SimNode(Node):
         self.create_service(RemoveObstacle, '~/remove_obstacle', self._on_remove)
 
         wall = Clock(clock_type=ClockType.STEADY_TIME)
-        if cfg.lockstep:
+        if self._wall is not None:
+            # Finer than a period, so that a late call is caught up by the next one.
+            self.create_timer(0.5 * cfg.control_period, self._on_wall_timer, clock=wall)
+        elif cfg.lockstep:
             self.create_timer(self._lockstep.tick_period_ns * 1e-9, self._on_lockstep_timer,
                               clock=wall)
         elif cfg.real_time_factor > 0.0:
@@ -93,7 +109,9 @@ class SimNode(Node):
             f'{cfg.physics.robot_variant} car, time_step {cfg.physics.time_step} s, control '
             f'period {cfg.control_period} s, '
             + ('lockstep' if cfg.lockstep else f'real_time_factor {cfg.real_time_factor}')
-            + (', paused' if self._lockstep.paused else ''))
+            + (', paused' if self._lockstep.paused else '')
+            + (', wall clock (no /clock)' if self._wall is not None else '')
+            + f', sensor profile {cfg.sensors.name}')
 
     def destroy_node(self) -> None:
         self.sim.close()
@@ -101,19 +119,56 @@ class SimNode(Node):
 
     # --- stepping --------------------------------------------------------------------------
 
+    def _stamp_ns(self) -> int:
+        """Return the stamp [ns] of the current state: its sim time, or the system clock's."""
+        sim_ns = self.sim.steps * self._time_step_ns  # [ns]
+        return sim_ns if self._wall is None else self._wall.stamp_ns(sim_ns)
+
     def _stamp(self):
-        return sim_time_msg(self.sim.steps, self._time_step_ns)
+        return Time(sec=self._stamp_ns() // 1_000_000_000,
+                    nanosec=self._stamp_ns() % 1_000_000_000)
+
+    def _step_physics(self, steps: int) -> None:
+        """Step the physics, applying each delayed command at its physics step."""
+        end = self.sim.steps + steps
+        while True:
+            for command in self._commands.due(self.sim.steps):
+                self._apply(*command)
+            if self.sim.steps >= end:
+                return
+            due = self._commands.next_step()
+            self.sim.step((end if due is None else min(end, max(due, self.sim.steps + 1)))
+                          - self.sim.steps)
 
     def _advance(self) -> None:
         """One control period of physics, then publish the new state."""
-        self.sim.step(self.config.steps_per_period)
-        self._periods += 1
-        now = time.monotonic_ns()  # [ns]
-        self._lockstep.advanced(self._publish_messages(), now)
+        while True:
+            self._step_physics(self.config.steps_per_period)
+            self._periods += 1
+            now = time.monotonic_ns()  # [ns]
+            stamp, lost = self._publish_messages()
+            self._lockstep.advanced(stamp, now)
+            # A lost state gets no answer: in lockstep the board goes on with the command it
+            # has, as if answered, so that the chain stays deterministic.
+            if not (lost and self.config.lockstep and self._lockstep.heard(stamp, now)):
+                return
 
     def _advance_if_running(self) -> None:
         if not self._lockstep.paused:
             self._advance()
+
+    def _on_wall_timer(self) -> None:
+        if self._lockstep.paused:
+            return
+        sim_ns = self.sim.steps * self._time_step_ns  # [ns]
+        skipped = self._wall.skipped_ns
+        for _ in range(self._wall.due(sim_ns, time.time_ns())):
+            self._advance()
+        if self._wall.skipped_ns > skipped:
+            self.get_logger().warn(
+                f'the sim fell more than {MAX_LAG_NS * 1e-9} s behind the system clock: '
+                f'skipped {(self._wall.skipped_ns - skipped) * 1e-9:.3f} s (the machine is '
+                'too busy to run it at real time)', throttle_duration_sec=5.0)
 
     def _on_fast_timer(self) -> None:
         deadline = time.monotonic() + FAST_BATCH_WALL_TIME
@@ -132,25 +187,41 @@ class SimNode(Node):
             self._publish_state()
 
     def _publish_state(self) -> None:
-        self._lockstep.published(self._publish_messages(), time.monotonic_ns())
+        now = time.monotonic_ns()  # [ns]
+        stamp, lost = self._publish_messages()
+        self._lockstep.published(stamp, now)
+        if lost and self.config.lockstep and self._lockstep.heard(stamp, now):
+            self._advance()
 
-    def _publish_messages(self) -> int:
-        """Publish the current state; return its stamp [ns]."""
+    def _publish_messages(self) -> tuple[int, bool]:
+        """Publish the current state; return its stamp [ns] and whether it was lost."""
         messages = self._messages
-        state = self.sim.state()
-        sec, nanosec = sim_time(self.sim.steps, self._time_step_ns)
-        if self._periods % self.config.clock_every == 0:
-            self._clock_pub.publish(messages.clock(sec, nanosec))
-        self._joint_pub.publish(messages.joint_state(state, sec, nanosec))
+        truth = state = self.sim.state()
+        lost = False
+        if self._sensors is not None:
+            sample = self._sensors.sample(state)
+            lost = sample.lost
+            state = dataclasses.replace(
+                state, positions=sample.positions, velocities=sample.velocities,
+                orientation=sample.orientation, angular_velocity=sample.angular_velocity,
+                linear_acceleration=sample.linear_acceleration)
+        if self._wall is None:
+            sec, nanosec = sim_time(self.sim.steps, self._time_step_ns)
+            if self._periods % self.config.clock_every == 0:
+                self._clock_pub.publish(messages.clock(sec, nanosec))
+        else:
+            sec, nanosec = divmod(self._stamp_ns(), 1_000_000_000)
+        if not lost:
+            self._joint_pub.publish(messages.joint_state(state, sec, nanosec))
         # imu and ground truth are built only when heard (asking: 1.5 us; building and
         # publishing to nobody: 10 us); a subscriber that appears gets the next one anyway.
-        if (self._periods % self.config.imu_every == 0
+        if (not lost and self._periods % self.config.imu_every == 0
                 and self._imu_pub.get_subscription_count()):
             self._imu_pub.publish(messages.imu(state, sec, nanosec))
         if (self._periods % self.config.ground_truth_every == 0
                 and self._odom_pub.get_subscription_count()):
-            self._odom_pub.publish(messages.odometry(state, sec, nanosec))
-        return sec * 1_000_000_000 + nanosec
+            self._odom_pub.publish(messages.odometry(truth, sec, nanosec))
+        return sec * 1_000_000_000 + nanosec, lost
 
     # --- callbacks -------------------------------------------------------------------------
 
@@ -164,12 +235,13 @@ class SimNode(Node):
             return  # it answers a state of the world before the last reset
         if self._stale(computed):
             return
-        try:
-            self.sim.set_command(swivel_torque, drive_speed)
-        except ValueError as error:
-            self.get_logger().warn(f'ignoring actuator_command: {error}',
-                                   throttle_duration_sec=1.0)
-            return
+        if self._sensors is None:
+            if not self._apply(swivel_torque, drive_speed):
+                return
+        elif not self._sensors.transport.lost():
+            # Lost: the board never hears it and goes on with the command it has.
+            self._commands.push(self.sim.steps, self._sensors.transport.command_delay(),
+                                (swivel_torque, drive_speed))
         if not self.config.lockstep:
             return
         timed_out = self._lockstep.unanswered
@@ -178,6 +250,16 @@ class SimNode(Node):
             self.get_logger().info(f'{LOCKSTEP_RESUMED_LOG}: waiting for it every period again')
         if advance:
             self._advance()
+
+    def _apply(self, swivel_torque: float, drive_speed: float) -> bool:
+        """Give the physics a command; False: refused (logged)."""
+        try:
+            self.sim.set_command(swivel_torque, drive_speed)
+        except ValueError as error:
+            self.get_logger().warn(f'ignoring actuator_command: {error}',
+                                   throttle_duration_sec=1.0)
+            return False
+        return True
 
     def _stale(self, computed: int) -> bool:
         """
@@ -189,18 +271,21 @@ class SimNode(Node):
         then stops the car. An unstamped command (stamp 0) counts as fresh.
         """
         watchdog = self.config.physics.watchdog_timeout
-        age = (self.sim.steps * self._time_step_ns - computed) * 1e-9  # [s]
+        age = (self._stamp_ns() - computed) * 1e-9  # [s]
         if self.config.lockstep or watchdog == 0.0 or computed == 0 or age <= watchdog:
             return False
+        clock = 'sim' if self._wall is None else 'system clock'
         self.get_logger().warn(
-            f'dropping actuator_command computed {age:.2f} s of sim time ago (watchdog_timeout '
-            f'{watchdog} s): the controller is behind the sim; free running with '
-            f'real_time_factor {self.config.real_time_factor}, lockstep keeps them together',
-            throttle_duration_sec=5.0)
+            f'dropping actuator_command computed {age:.2f} s of {clock} time ago '
+            f'(watchdog_timeout {watchdog} s): the controller is behind the sim; free running '
+            f'with real_time_factor {self.config.real_time_factor}, lockstep keeps them '
+            'together', throttle_duration_sec=5.0)
         return True
 
     def _on_set_paused(self, request: SetBool.Request, response: SetBool.Response):
         advance = self._lockstep.set_paused(request.data, time.monotonic_ns())
+        if self._wall is not None and not request.data:
+            self._wall.restart(self.sim.steps * self._time_step_ns, time.time_ns())
         response.success = True
         response.message = 'paused' if request.data else 'running'
         if advance:
@@ -226,12 +311,12 @@ class SimNode(Node):
             per_period = self.config.steps_per_period
             while remaining > 0:
                 chunk = min(remaining, per_period - self.sim.steps % per_period)
-                self.sim.step(chunk)
+                self._step_physics(chunk)
                 remaining -= chunk
                 if self.sim.steps % per_period == 0:
                     self._periods += 1
                     self._publish_state()
-            self._lockstep.stepped(self.sim.steps * self._time_step_ns)
+            self._lockstep.stepped(self._stamp_ns())
             response.success = True
             response.message = f'stepped {request.steps} steps'
         response.sim_time = self._stamp()
@@ -239,6 +324,9 @@ class SimNode(Node):
 
     def _on_run(self, request: StepSimulation.Request, response: StepSimulation.Response):
         refusal = self._steps_refusal(request.steps)
+        if refusal is None and self._wall is not None:
+            refusal = ('~/run counts sim time, and with clock_source wall the sim runs at real '
+                       'time: use ~/set_paused')
         if refusal is not None:
             response.success = False
             response.message = refusal
@@ -262,6 +350,7 @@ class SimNode(Node):
             response.success = False
             response.message = f'reset refused: {error}'
             return response
+        self._commands.clear()
         response.success = True
         response.message = f'robot at ({request.x}, {request.y}, {request.yaw})'
         # The reset takes the rest of this control period, with the zero command it set: the
@@ -271,8 +360,14 @@ class SimNode(Node):
         self.sim.step(self.config.steps_per_period
                       - self.sim.steps % self.config.steps_per_period)
         self._periods += 1
+        if self._sensors is not None:
+            self._sensors.reset(self.sim.state())  # a new world: the sensors start afresh
         self._reset_pub.publish(Header(stamp=self._stamp(), frame_id=self.config.world_frame_id))
-        self._lockstep.reset(self._publish_messages(), time.monotonic_ns())
+        now = time.monotonic_ns()  # [ns]
+        stamp, lost = self._publish_messages()
+        self._lockstep.reset(stamp, now)
+        if lost and self.config.lockstep and self._lockstep.heard(stamp, now):
+            self._advance()
         return response
 
     def _on_spawn(self, request: SpawnObstacle.Request, response: SpawnObstacle.Response):

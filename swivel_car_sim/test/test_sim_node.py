@@ -160,15 +160,7 @@ def test_lockstep_pace_cap_holds_sim_time_below_wall_time(harness_factory):
 
 def _lockstep_run(h: Harness, periods: int) -> JointState:
     """Answer each new state with a command that depends on it, as a controller would."""
-    spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
-    answered = set()
-    while h.sim.sim.steps < periods * 5:
-        latest = h.joint_states[-1]
-        if _ns(latest.header.stamp) not in answered:
-            answered.add(_ns(latest.header.stamp))
-            h.command(latest.header.stamp, swivel_torque=60.0 * (0.4 - latest.position[0]),
-                      drive_speed=4.0)
-        h.executor.spin_once(timeout_sec=0.05)
+    _answer_every_state(h, periods)
     spin_until(h.executor, lambda: _ns(h.joint_states[-1].header.stamp) == periods * 10**7,
                TIMEOUT, 'last state')
     return h.joint_states[-1]
@@ -378,3 +370,80 @@ def test_frame_ids_are_parameters(harness_factory):
     assert (h.odom[-1].header.frame_id, h.odom[-1].child_frame_id) == ('map',
                                                                        'robot1/base_link')
     assert h.imu[-1].header.frame_id == 'robot1/base_link'
+
+
+def _answer_every_state(h: Harness, periods: int) -> None:
+    """Answer each new state as a controller would until ``periods`` have passed."""
+    spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
+    answered = set()
+    while h.sim.sim.steps < periods * 5:
+        latest = h.joint_states[-1]
+        if _ns(latest.header.stamp) not in answered:
+            answered.add(_ns(latest.header.stamp))
+            h.command(latest.header.stamp, swivel_torque=60.0 * (0.4 - latest.position[0]),
+                      drive_speed=4.0)
+        h.executor.spin_once(timeout_sec=0.05)
+
+
+def test_lockstep_with_the_realistic_sensors_is_deterministic(harness_factory):
+    runs = []
+    for _ in range(2):
+        h = harness_factory(lockstep=True, lockstep_timeout=0.0, sensor_profile='realistic',
+                            sensor_seed=3)
+        _answer_every_state(h, 60)
+        runs.append((h.sim.sim.state(), h.joint_states[-1]))
+    (truth, first), (truth2, second) = runs
+    assert list(truth.positions) == list(truth2.positions)
+    assert list(first.position) == list(second.position)
+    assert list(first.velocity) == list(second.velocity)
+    assert truth.positions[0] > 0.03  # the swivel moved
+    wheel_tick = 2.0 * math.pi / 1920.0  # [rad] the shipped profile's 64 CPR x 30:1
+    swivel_tick = 2.0 * math.pi / 16384.0  # [rad] 14 bit
+    assert first.position[1] / wheel_tick == pytest.approx(round(
+        first.position[1] / wheel_tick), abs=1e-6)
+    assert first.position[0] / swivel_tick == pytest.approx(round(
+        first.position[0] / swivel_tick), abs=1e-6)
+    assert first.position[0] != truth.positions[0]
+
+
+def test_a_lost_state_does_not_hold_up_lockstep(harness_factory, tmp_path):
+    import yaml
+    from swivel_car_sim.sensor_models import shipped_profile
+    data = yaml.safe_load(shipped_profile('realistic').read_text())
+    data['transport']['drop_rate'] = 0.3
+    profile = tmp_path / 'lossy.yaml'
+    profile.write_text(yaml.safe_dump(data))
+    # lockstep_timeout 0 waits forever: a lost state that stalled the chain would hang here.
+    h = harness_factory(lockstep=True, lockstep_timeout=0.0, sensor_profile=str(profile))
+    _answer_every_state(h, 40)
+    stamps = sorted({_ns(m.header.stamp) for m in h.joint_states})
+    assert len(stamps) < 40  # 30 % lost: P(none of 40) = 0.7^40 < 1e-6 (and seeded)
+    assert h.sim.sim.steps >= 40 * 5
+
+
+def test_wall_clock_stamps_from_the_system_clock_without_clock(harness_factory):
+    start = time.time_ns()
+    h = harness_factory(clock_source='wall', sensor_profile='realistic')
+    spin_until(h.executor, lambda: len(h.joint_states) > 20, TIMEOUT, 'joint_states')
+    h.command(h.joint_states[-1].header.stamp, drive_speed=5.0)
+    received = time.time_ns()
+    stamps = [_ns(m.header.stamp) for m in h.joint_states]
+    # Samples of the system clock: after the start, never in the future.
+    assert start <= stamps[0] and stamps[-1] <= received
+    # A fixed cadence: stamps advance as the physics does, one control period each (a lost
+    # state leaves a gap of two).
+    assert {b - a for a, b in zip(stamps, stamps[1:])} <= {10_000_000, 20_000_000}
+    assert not h.clock
+    spin_until(h.executor, lambda: h.joint_states[-1].velocity[1] > 1.0, TIMEOUT,
+               'the command applied')
+
+
+def test_wall_clock_refuses_run_and_a_stamp_older_than_the_watchdog(harness_factory):
+    h = harness_factory(clock_source='wall', start_paused=True)
+    response = h.call(StepSimulation, 'run', StepSimulation.Request(steps=50))
+    assert not response.success and 'set_paused' in response.message
+    assert h.call(SetBool, 'set_paused', SetBool.Request(data=False)).success
+    old = time.time_ns() - 600_000_000  # [ns] computed 0.6 s ago, by the system clock
+    h.command(Time(sec=old // 10**9, nanosec=old % 10**9), drive_speed=5.0)
+    spin_until(h.executor, lambda: h.sim.sim.time > 0.05, TIMEOUT, 'running')
+    assert h.sim.sim.state().velocities[1] == pytest.approx(0.0, abs=0.05)
