@@ -67,6 +67,14 @@ DIFFERENTIALS = ('open', 'locked')
 BASE_LINK = 'base_link'
 FRONT_LINK = {'swivel': 'front_t', 'car_like': 'front_axle'}
 WHEEL_LINKS = ('rear_left_wheel', 'rear_right_wheel', 'front_left_wheel', 'front_right_wheel')
+CAMERA_LINK = 'camera_link'
+CAMERA_OPTICAL_FRAME = 'camera_depth_optical_frame'
+# The depth camera (a RealSense D435-class stereo camera) sits on the central body's top front
+# corner, looking forward and pitched down so that its 58 deg vertical view spans the ground
+# from just past the front wheels to beyond the horizon: steps from about 0.3 m to 2 m
+# ahead of the front axle. Its housing is left out of the mass layout (72 g against 21 kg).
+CAMERA_PITCH = 0.35  # [rad] optical axis below base_link's x axis
+CAMERA_CLEARANCE = 0.015  # [m] lens ahead of and above the body's box
 
 
 def described(default: Any, description: str) -> Any:
@@ -190,7 +198,7 @@ class CarDescription:
         apex = self.apex
         rod = min(0.02, self.r / 3.0, self.h / 4.0)  # [m] radius of columns and housings
         axle_half = np.array([0.0, self.h - self.wheel_width / 2.0, 0.0])
-        body_size = np.array([0.4 * self.l, 0.6 * self.h, 0.25 * self.l])
+        body_size = self.body_size
         front_link = FRONT_LINK[variant]
         parts = [Part.rod('rear_axle', BASE_LINK, self.rear_axle_mass, rod,
                           -axle_half, axle_half),
@@ -208,6 +216,26 @@ class CarDescription:
             parts.append(Part.rod(link, link, self.wheel_mass, self.r, centre - half_tread,
                                   centre + half_tread))
         return parts
+
+    @property
+    def body_size(self) -> np.ndarray:
+        """Edges of the central body's box along base_link x, y, z [m]."""
+        return np.array([0.4 * self.l, 0.6 * self.h, 0.25 * self.l])
+
+    def camera_mount(self) -> tuple[np.ndarray, float]:
+        """
+        Return where the depth camera's ``camera_link`` sits in base_link at rest.
+
+        Returns
+        -------
+        (position [m], pitch [rad]): the lens centre, and the optical axis' angle below
+        base_link's x axis (camera_link's rotation about base_link's y axis).
+
+        """
+        size = self.body_size
+        position = self.apex + np.array([self.body_offset + size[0] / 2.0 + CAMERA_CLEARANCE,
+                                         0.0, size[2] / 2.0 + CAMERA_CLEARANCE])
+        return position, CAMERA_PITCH
 
     def wheel_centres(self) -> list[np.ndarray]:
         """

@@ -114,7 +114,8 @@ class SwivelCarSim:
         self.description = self.config.description
         self.params = self.config.params
         self.robot: RobotModel = build_robot(self.description, self.config.robot_variant,
-                                             body_collision=self.config.body_collision)
+                                             body_collision=self.config.body_collision,
+                                             sensor_frames=False)
         self._drive_train = DriveTrain(self.description, self.config.time_step)
         # Read by the watchdog every physics step.
         self._time_step = self.config.time_step  # [s]
@@ -159,6 +160,11 @@ class SwivelCarSim:
     def steps(self) -> int:
         """Physics steps taken since construction [1]."""
         return self._steps
+
+    @property
+    def client(self) -> int:
+        """Return the pybullet physics client of the world (for sensors that render it)."""
+        return self._client
 
     @property
     def time(self) -> float:

@@ -27,6 +27,7 @@ from swivel_car_msgs.srv import (RemoveObstacle, ResetSimulation, SpawnObstacle,
 from swivel_car_ros.lockstep import SimLockstep
 from swivel_car_ros.ros_params import run_node, STATE_QUEUE_DEPTH
 from swivel_car_ros.serialized import read_logged
+from swivel_car_sim.camera_publisher import CameraPublisher
 from swivel_car_sim.config import PARAMETERS, SimNodeConfig
 from swivel_car_sim.conversions import (
     actuator_command_fields, sim_time, sim_time_msg, StateMessages)
@@ -61,6 +62,12 @@ class SimNode(Node):
             raise ValueError(f'sim: invalid parameter: {error}') from error
         cfg = self.config
         self.sim = SwivelCarSim(cfg.physics, cfg.initial_pose)
+        try:
+            self._camera = CameraPublisher(self, self.sim.client, self.sim.description,
+                                           cfg.control_period)
+        except ValueError as error:
+            self.sim.close()
+            raise ValueError(f'sim: invalid parameter: {error}') from error
         self._time_step_ns = round(cfg.physics.time_step * 1e9)
         # When to advance (lockstep and pause): docs/architecture.md.
         self._lockstep = SimLockstep(
@@ -213,6 +220,7 @@ class SimNode(Node):
             sec, nanosec = divmod(self._stamp_ns(), 1_000_000_000)
         if not lost:
             self._joint_pub.publish(messages.joint_state(state, sec, nanosec))
+        self._camera.after_period(self._periods, truth, sec, nanosec)
         # imu and ground truth are built only when heard (asking: 1.5 us; building and
         # publishing to nobody: 10 us); a subscriber that appears gets the next one anyway.
         if (not lost and self._periods % self.config.imu_every == 0

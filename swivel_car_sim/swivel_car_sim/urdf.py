@@ -26,8 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from swivel_car_model.description import (
-    BASE_LINK, CarDescription, combine, FRONT_LINK, inertia_about_y_axis, Part,
-    ROBOT_VARIANTS, WHEEL_LINKS)
+    BASE_LINK, CAMERA_LINK, CAMERA_OPTICAL_FRAME, CarDescription, combine, FRONT_LINK,
+    inertia_about_y_axis, Part, ROBOT_VARIANTS, WHEEL_LINKS)
 
 WHEEL_JOINTS = ('rear_left_wheel_joint', 'rear_right_wheel_joint',
                 'front_left_wheel_joint', 'front_right_wheel_joint')
@@ -115,12 +115,13 @@ def _link(name: str, parts: list[Part], origin: np.ndarray, collision: str = '')
 
 
 def _joint(name: str, kind: str, parent: str, child: str, xyz: np.ndarray,
-           axis: np.ndarray | None = None, limit: float | None = None) -> str:
+           axis: np.ndarray | None = None, limit: float | None = None,
+           rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> str:
     # Generous effort and velocity limits: pybullet reads them, and the sim applies the
     # description's actuator limits itself (the drive train model, the swivel clamp).
     effort, velocity = 1000.0, 100.0
     text = (f'  <joint name="{name}" type="{kind}"><parent link="{parent}"/>'
-            f'<child link="{child}"/><origin xyz="{_fmt(xyz)}" rpy="0 0 0"/>')
+            f'<child link="{child}"/><origin xyz="{_fmt(xyz)}" rpy="{_fmt(rpy)}"/>')
     if axis is not None:
         text += f'<axis xyz="{_fmt(axis)}"/>'
     if limit is not None:
@@ -143,9 +144,25 @@ def _wheel_collision(d: CarDescription) -> str:
             '</geometry></collision>')
 
 
+def _camera_frames(d: CarDescription) -> str:
+    """
+    Return the depth camera's frames: ``camera_link`` and its REP-103 optical frame.
+
+    Links without an inertial: they are frames for TF, not bodies (pybullet would give each a
+    mass of 1 kg, so the sim loads the robot without them and places its camera itself).
+    """
+    position, pitch = d.camera_mount()
+    return (f'  <link name="{CAMERA_LINK}"/>\n  <link name="{CAMERA_OPTICAL_FRAME}"/>\n'
+            + _joint(f'{CAMERA_LINK}_joint', 'fixed', BASE_LINK, CAMERA_LINK, position,
+                     rpy=(0.0, pitch, 0.0))
+            # Optical: z forward, x right, y down.
+            + _joint(f'{CAMERA_OPTICAL_FRAME}_joint', 'fixed', CAMERA_LINK,
+                     CAMERA_OPTICAL_FRAME, np.zeros(3), rpy=(-math.pi / 2.0, 0.0, -math.pi / 2.0)))
+
+
 def build_robot(description: CarDescription, variant: str = 'swivel',
                 max_steering: float = CAR_LIKE_MAX_STEERING,
-                body_collision: bool = False) -> RobotModel:
+                body_collision: bool = False, sensor_frames: bool = True) -> RobotModel:
     """
     Generate the URDF of a swivel car or of the car-like baseline.
 
@@ -162,6 +179,9 @@ def build_robot(description: CarDescription, variant: str = 'swivel',
     body_collision : bool
         Give the columns, axle housings and central body collision shapes too (default:
         the wheels only; see the module docstring).
+    sensor_frames : bool
+        Add the depth camera's frames (``CarDescription.camera_mount``); the sim leaves
+        them out.
 
     Returns
     -------
@@ -209,6 +229,7 @@ def build_robot(description: CarDescription, variant: str = 'swivel',
             + ''.join(_joint(j, 'continuous', parent, link, origins[link] - origins[parent],
                              axis=np.array([0, 1.0, 0]))
                       for j, parent, link in zip(WHEEL_JOINTS, wheel_parents, WHEEL_LINKS))
+            + (_camera_frames(d) if sensor_frames else '')
             + '</robot>\n')
     return RobotModel(text, variant, steer_joint, WHEEL_JOINTS, total_mass,
                       inertia_about_y_axis(parts), com)

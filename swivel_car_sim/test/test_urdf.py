@@ -39,7 +39,8 @@ def test_urdf_carries_the_description_masses(description, variant):
 @pytest.mark.parametrize('variant', ROBOT_VARIANTS)
 def test_urdf_inertials_give_the_description_centre_of_mass_in_pybullet(variant, tmp_path):
     description = CarDescription(body_mass=10.0, body_offset=0.04)
-    robot = build_robot(description, variant)
+    # As the sim loads it: pybullet gives the camera's inertia-less frames 1 kg each.
+    robot = build_robot(description, variant, sensor_frames=False)
     path = tmp_path / 'robot.urdf'
     path.write_text(robot.urdf)
     client = pybullet.connect(pybullet.DIRECT)
@@ -63,7 +64,7 @@ def test_urdf_inertials_give_the_description_centre_of_mass_in_pybullet(variant,
 @pytest.mark.parametrize('description', DESIGNS)
 @pytest.mark.parametrize('variant', ROBOT_VARIANTS)
 def test_designs_load_in_pybullet_with_the_contract_joints(description, variant, tmp_path):
-    robot = build_robot(description, variant)
+    robot = build_robot(description, variant, sensor_frames=False)  # as the sim loads it
     params = description.model_params()
     path = tmp_path / 'robot.urdf'
     path.write_text(robot.urdf)
@@ -103,3 +104,25 @@ def test_wheels_sit_where_the_params_say():
 def test_unknown_variant_is_refused():
     with pytest.raises(ValueError, match='robot_variant'):
         build_robot(CarDescription(), 'tank')
+
+
+def test_camera_frames_sit_where_the_description_mounts_the_camera():
+    description = CarDescription(body_offset=0.03)
+    root = ET.fromstring(build_robot(description).urdf)
+    joints = {j.get('name'): j for j in root.iter('joint')}
+    mount = joints['camera_link_joint']
+    position, pitch = description.camera_mount()
+    assert (mount.find('parent').get('link'), mount.find('child').get('link')) == \
+        ('base_link', 'camera_link')
+    np.testing.assert_allclose([float(v) for v in mount.find('origin').get('xyz').split()],
+                               position, atol=1e-9)
+    np.testing.assert_allclose([float(v) for v in mount.find('origin').get('rpy').split()],
+                               [0.0, pitch, 0.0], atol=1e-9)
+    optical = joints['camera_depth_optical_frame_joint']
+    roll, _, yaw = (float(v) for v in optical.find('origin').get('rpy').split())
+    # REP 103: the optical z (forward) is camera_link's x, optical x (right) its -y.
+    rotation = np.array(pybullet.getMatrixFromQuaternion(
+        pybullet.getQuaternionFromEuler([roll, 0.0, yaw]))).reshape(3, 3)
+    np.testing.assert_allclose(rotation[:, 2], [1.0, 0.0, 0.0], atol=1e-8)
+    np.testing.assert_allclose(rotation[:, 0], [0.0, -1.0, 0.0], atol=1e-8)
+    assert 'camera_link' not in build_robot(description, sensor_frames=False).urdf
