@@ -178,6 +178,7 @@ class PlannerNode(Node):
         self._clock_last = -math.inf  # [s] the node clock at the last input heard
         self._clock_moved_wall = -math.inf  # [s] steady clock when an input last saw it move
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
+        self._refusals = inputs.RefusalLog(5.0)  # [s] as read_logged's lines
         self._last_tick = 0.0  # [s] node clock when the running climb last had a tick
         self._last_tick_wall = 0.0  # [s] steady clock then
         self._last_tick_stamp = -math.inf  # [s] the stamp of the climb's last engaged tick
@@ -267,27 +268,34 @@ class PlannerNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _on_odom(self, data: bytes) -> None:
-        if self._heard(inputs.ODOM):
-            fields = read_logged(self.get_logger(), odom_fields, data, inputs.ODOM)
-            if fields is not None:
-                stamp, x, y, orientation, speed = fields
-                self._add(inputs.ODOM, stamp, inputs.odom_values(x, y, orientation, speed))
+        self._take(inputs.ODOM, data, odom_fields, inputs.odom_values)
 
     def _on_imu(self, data: bytes) -> None:
-        if self._heard(inputs.IMU):
-            fields = read_logged(self.get_logger(), imu_fields, data, inputs.IMU)
-            if fields is not None:
-                stamp, orientation = fields
-                self._add(inputs.IMU, stamp, inputs.imu_values(orientation))
+        self._take(inputs.IMU, data, imu_fields, inputs.imu_values)
 
     def _on_controller_state(self, data: bytes) -> None:
-        if self._heard(_CONTROLLER_STATE):
-            fields = read_logged(self.get_logger(), controller_state_fields, data,
-                                 _CONTROLLER_STATE)
-            if fields is not None:
-                stamp, set_point, swivel, swivel_rate, torque, command_stamp = fields
-                self._add(_CONTROLLER_STATE, stamp, inputs.controller_state_values(
-                    set_point, torque, moment_seconds(command_stamp), swivel, swivel_rate))
+        def values(set_point, swivel, swivel_rate, torque, command_stamp):
+            return inputs.controller_state_values(
+                set_point, torque, moment_seconds(command_stamp), swivel, swivel_rate)
+
+        self._take(_CONTROLLER_STATE, data, controller_state_fields, values)
+
+    def _take(self, topic: str, data: bytes, read: Callable, values: Callable) -> None:
+        """Read a serialized input and add its values, while a climb runs; refuse a bad one."""
+        if not self._heard(topic):
+            return
+        fields = read_logged(self.get_logger(), read, data, topic)
+        if fields is None:
+            return
+        stamp, *raw = fields
+        try:
+            value = values(*raw)
+        except ValueError as error:
+            line = self._refusals.line(topic, str(error), time.monotonic())
+            if line is not None:
+                self.get_logger().error(line)
+            return
+        self._add(topic, stamp, value)
 
     def _heard(self, topic: str) -> bool:
         """

@@ -410,6 +410,41 @@ def test_a_moment_far_ahead_is_not_acted_on(rig):
     assert all(not m.hold or m.drive_speed == 0.0 for m in rig.received[before:])
 
 
+@pytest.mark.parametrize('bad', [math.nan, math.inf])
+def test_moments_of_non_finite_inputs_are_refused_and_never_reach_a_command(rig, capfd, bad):
+    # Every float field of every input non-finite, for one moment every 0.25 s of the climb
+    # (in each step), ahead of the real inputs of that moment.
+    imu, odom = Imu(), Odometry()
+    for vector in (imu.orientation, odom.pose.pose.position, odom.pose.pose.orientation,
+                   odom.twist.twist.linear):
+        for axis in ('x', 'y', 'z', 'w') if hasattr(vector, 'w') else ('x', 'y', 'z'):
+            setattr(vector, axis, bad)
+    state = SwivelControllerState(**{name: bad for name in (
+        'set_point', 'target', 'measured', 'measured_rate', 'error', 'torque')}, source='hold')
+    publish_state = rig.publish_state
+
+    def with_a_bad_moment(*args, **kwargs):
+        if rig.car.cycles % 25 == 0:
+            state.swivel_command_stamp = rig.heard
+            stamp = rclpy.time.Time(nanoseconds=rig.car.cycles * 10_000_000).to_msg()
+            for msg, publisher in ((imu, rig.imu), (odom, rig.odom), (state, rig.state)):
+                msg.header.stamp = stamp
+                publisher.publish(msg)
+        publish_state(*args, **kwargs)
+
+    rig.warm_up()
+    rig.publish_state = with_a_bad_moment
+    response = rig.drive(rig.call(**SUCCESSFUL_CLIMB))
+    assert response.success, response.message
+    for msg in rig.received:
+        assert all(math.isfinite(v) for v in (msg.angle, msg.max_rate, msg.drive_speed)), msg
+    log = capfd.readouterr().err
+    for line in ('imu refused: orientation.x must be a finite number',
+                 'odom refused: pose.pose.position.x must be a finite number',
+                 'controller/controller_state refused: set_point must be a finite number'):
+        assert line in log, log
+
+
 def test_a_sim_running_ahead_of_the_first_command_does_not_end_the_climb(rig):
     """
     Check the planner repeats its first command until the controller has heard it.
