@@ -6,7 +6,15 @@ VENV := .venv
 STAMP := $(VENV)/.requirements-installed
 # The nodes are Python: the messages' C++ interfaces are built only on request (MSGS_CPP=ON).
 MSGS_CPP ?= OFF
-BUILT := ros2_ws/install/.swivel_car_built_msgs_cpp_$(MSGS_CPP)
+# tf2_msgs (/tf, /tf_static): the underlay's where it has one (a full Jazzy install sourced,
+# or the venv), else the workspace's own copy of the interface, tf2_msgs/ (the wheels on PyPI
+# have none). Outside ros2_ws/src, so that a plain colcon build there never shadows the system's.
+TF2_MSGS_UNDERLAY := $(firstword $(foreach prefix,$(VENV) $(subst :, ,$(AMENT_PREFIX_PATH)),\
+    $(if $(findstring $(CURDIR)/ros2_ws/,$(abspath $(prefix))/),,\
+    $(wildcard $(prefix)/share/ament_index/resource_index/packages/tf2_msgs))))
+MSGS_PACKAGES := swivel_car_msgs $(if $(TF2_MSGS_UNDERLAY),,tf2_msgs)
+BUILT := ros2_ws/install/.swivel_car_built_msgs_cpp_$(MSGS_CPP)$(if \
+    $(TF2_MSGS_UNDERLAY),_tf2_msgs_underlay)
 IN_WS := scripts/in_ws
 PYTEST_ARGS ?=
 PYTEST_WORKERS ?= $(shell echo $$(( $$(nproc) + 1 )))
@@ -31,7 +39,7 @@ build: $(BUILT)
 # needs no build; what colcon installs otherwise (manifests, setup files, interfaces, config,
 # launch and resource files) does, and a build is then due. A build that changes nothing
 # still takes colcon 11 s.
-BUILD_INPUTS := $(shell find swivel_car_* -type f -not -path '*/__pycache__/*' \( \
+BUILD_INPUTS := $(shell find swivel_car_* tf2_msgs -type f -not -path '*/__pycache__/*' \( \
     -name package.xml -o -name setup.py -o -name setup.cfg -o -name CMakeLists.txt \
     -o -path '*/msg/*' -o -path '*/srv/*' -o -path '*/action/*' -o -path '*/config/*' \
     -o -path '*/launch/*' -o -path '*/resource/*' \))
@@ -48,6 +56,7 @@ $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	@# A file removed from a package leaves a dangling symlink that fails the symlink install.
 	find ros2_ws/build ros2_ws/install -xtype l -delete 2>/dev/null || true
 	rm -f ros2_ws/install/.swivel_car_built_*
+	$(if $(TF2_MSGS_UNDERLAY),rm -rf ros2_ws/build/tf2_msgs ros2_ws/install/tf2_msgs)
 	@# Each colcon marks a new build and install directory at its start: two at once on a fresh
 	@# workspace, one read the other's marker while it was being written and refused the build.
 	cd ros2_ws && ../$(IN_WS) python -c 'from colcon_core.verb import check_and_mark_build_tool \
@@ -55,7 +64,8 @@ $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	    install("install", merge_install=False)'
 	cd ros2_ws && { ../$(IN_WS) colcon --log-base log/python_packages build $(COLCON_BUILD_ARGS) \
 	    --packages-ignore swivel_car_msgs & python_packages=$$!; }; \
-	MAKEFLAGS=-j$$(nproc) ../$(IN_WS) colcon build $(COLCON_BUILD_ARGS) --packages-select swivel_car_msgs \
+	MAKEFLAGS=-j$$(nproc) ../$(IN_WS) colcon build $(COLCON_BUILD_ARGS) \
+	    --base-paths src ../tf2_msgs --packages-select $(MSGS_PACKAGES) \
 	    --cmake-args -DBUILD_TESTING=OFF -DSWIVEL_CAR_MSGS_CPP=$(MSGS_CPP); msgs=$$?; \
 	wait $$python_packages && exit $$msgs
 	touch $@
@@ -65,7 +75,14 @@ $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 # machine 3 workers took 118-129 s where 2 took 141 s. Each worker claims its own block of ROS
 # domain ids. A file stays on one worker (module fixtures carry a stack from test to test), in
 # the order pytest.ini lists them.
-test: build
+# Foxglove's own bag parsers for tests/test_tf.py, from npm, pinned by the lock file (10
+# packages, 4 MB: 4 s).
+FOXGLOVE_NPM := tests/foxglove/node_modules/.package-lock.json
+$(FOXGLOVE_NPM): tests/foxglove/package.json tests/foxglove/package-lock.json
+	npm ci --prefix tests/foxglove --no-audit --no-fund --silent
+	touch $@
+
+test: build $(FOXGLOVE_NPM)
 	@echo '== running every test'
 	$(IN_WS) python -m pytest -n $(PYTEST_WORKERS) --dist loadfile --no-loadscope-reorder \
 	    $(PYTEST_ARGS)

@@ -21,6 +21,30 @@ from swivel_car_sim.world import StepSpec
 matplotlib.use('Agg')
 
 FRAME_COUNT = 8
+# The report's Python example: it reads the bag and plots one topic (run by tests/test_tf.py on
+# a bag the real recorder wrote).
+READING_EXAMPLE = """\
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+from rosbags.highlevel import AnyReader
+
+with AnyReader([Path('report/bag')]) as reader:
+    joint_states = [c for c in reader.connections if c.topic == '/joint_states']
+    t, swivel = [], []
+    for connection, _, data in reader.messages(connections=joint_states):
+        msg = reader.deserialize(data, connection.msgtype)
+        t.append(msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec)
+        swivel.append(msg.position[msg.name.index('swivel_joint')])
+plt.plot(t, swivel)
+plt.xlabel('sim time [s]')
+plt.ylabel('swivel angle [rad]')
+plt.savefig('swivel_angle.png')
+print(f'{len(t)} joint_states plotted to swivel_angle.png')
+"""
+# Shipped with swivel_car_bringup: 3D view following base_link, the swivel angle, pitch and
+# torque, and the climb's feedback.
+FOXGLOVE_LAYOUT = 'swivel_car_bringup/config/foxglove_layout.json'
 
 
 @dataclass
@@ -206,11 +230,21 @@ The swivel turned furthest:
 ## Opening the recording
 `bag/` holds every topic of the run (`/clock` included, sim time) with the message
 definitions, so no swivel_car package is needed to read it:
-- Foxglove: "Open local file", `report/bag/bag.mcap`; in the 3D panel add a URDF layer from
-  the topic `/robot_description`, with `base_link` as the display frame (the link frames need
-  `/tf`: with tf2_msgs installed `robot_description_node` records them; the live bridge,
-  `foxglove_bridge_node`, sends them itself on `/robot_frames`).
-- A full ROS 2 Jazzy install: `ros2 bag info report/bag`, `ros2 bag play report/bag --clock`.
-- Python: `rosbags` (`AnyReader`) or `mcap` with `mcap-ros2-support`.
+- Foxglove: "Open local file", `report/bag/bag.mcap`, then "Import layout" with
+  `{FOXGLOVE_LAYOUT}`: a 3D panel following `base_link` (the URDF from
+  `/robot_description`, placed by `/tf` and `/tf_static`), plots of the swivel angle, pitch
+  and swivel torque, and the climb's feedback (phase, progress and the raw message).
+- A full ROS 2 Jazzy install: `ros2 bag info report/bag`, `ros2 bag play report/bag --clock`;
+  RViz and `tf2_echo odom base_link` read the bag's `/tf` and `/tf_static`.
+- Python: `rosbags` (in the venv) reads every topic. Reading the bag and plotting one topic:
+
+```python
+{READING_EXAMPLE}```
+
+  Not `mcap` with `mcap-ros2-support` (0.6.0) for the whole bag: its message parser refuses
+  the action feedback's type name, `swivel_car_msgs/action/ClimbStep_FeedbackMessage`
+  (`'ClimbStep_FeedbackMessage' is an invalid message name`), and that ends the iteration at
+  the first `/climb_step/_action/feedback` message; `iter_decoded_messages(topics=[...])`
+  without that topic works.
 """)
     return page

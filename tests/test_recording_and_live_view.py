@@ -238,7 +238,7 @@ async def _foxglove_messages(port: int, topics: set[str], deadline: float) -> di
     return decoded
 
 
-def test_the_live_view_serves_decodable_joint_states_and_odom(ros_domain):
+def test_the_live_view_serves_decodable_joint_states_odom_and_tf(ros_domain):
     domain_id, _ = ros_domain
     port = _free_port()
     stack = _start(domain_id, ('swivel_car_sim', 'sim_node', {}),
@@ -247,7 +247,8 @@ def test_the_live_view_serves_decodable_joint_states_and_odom(ros_domain):
                    ('swivel_car_bringup', 'foxglove_bridge_node', {'port': port}))
     try:
         decoded = asyncio.run(_foxglove_messages(
-            port, {'/joint_states', '/odom', '/robot_description'}, time.monotonic() + 60.0))
+            port, {'/joint_states', '/odom', '/robot_description', '/tf', '/tf_static'},
+            time.monotonic() + 60.0))
     finally:
         codes = _stop(stack)
     assert set(codes.values()) == {0}, codes
@@ -255,6 +256,12 @@ def test_the_live_view_serves_decodable_joint_states_and_odom(ros_domain):
     assert len(decoded['/joint_states'].position) == len(decoded['/joint_states'].name)
     assert decoded['/odom'].child_frame_id == 'base_link'
     assert 'swivel_joint' in _urdf_joints(decoded['/robot_description'].data)
+    # The car's frames as Foxglove's 3D panel reads them: the stack's /tf (the odometry's and
+    # robot_description's) and /tf_static (latched: sent to a subscriber that comes later).
+    assert decoded['/tf'].transforms and {t.child_frame_id for t in decoded['/tf'].transforms} <= {
+        'base_link', 'front_t', 'rear_left_wheel', 'rear_right_wheel', 'front_left_wheel',
+        'front_right_wheel'}
+    assert type(decoded['/tf_static']).__name__ == 'TFMessage'
 
 
 def test_a_bad_output_is_one_fatal_line(ros_domain, tmp_path):

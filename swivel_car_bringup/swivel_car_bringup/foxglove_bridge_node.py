@@ -3,10 +3,10 @@ foxglove_bridge_node: a live view of the stack in Foxglove.
 
 Needs no RViz or ROS install on the viewing machine. Serves every topic of the graph (as they
 appear) over Foxglove's WebSocket protocol with the Foxglove SDK, as ``ros2msg`` schemas and CDR
-messages, the way the recorder writes them, so a bag and the live view open alike. Adds
-``/robot_frames`` (foxglove.FrameTransforms: odom -> base_link from ``odom`` and every link from
-``joint_states``), so the 3D panel shows the car from ``robot_description`` where tf2_msgs is
-missing.
+messages, the way the recorder writes them, so a bag and the live view open alike. The car's
+frames are the stack's own ``/tf`` (the odometry's odom -> base_link, robot_description_node's
+links) and ``/tf_static`` (transient local: the last message is sent to each new subscriber),
+which Foxglove's 3D panel reads as it reads them from a bag.
 
 Open Foxglove, "Open connection", ``ws://localhost:8765``.
 """
@@ -18,18 +18,12 @@ import sys
 from ament_index_python.packages import get_package_share_directory
 import foxglove
 from foxglove import Channel, Schema
-from foxglove.channels import FrameTransformsChannel
-from foxglove.messages import FrameTransform, FrameTransforms, Quaternion, Timestamp, Vector3
 from foxglove.websocket import ChannelView, Client, ServerListener
-from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from sensor_msgs.msg import JointState
-from std_msgs.msg import String
+from rclpy.qos import DurabilityPolicy
 
 from swivel_car_bringup.bag import MessageDefinitions, UnknownTypeError
-from swivel_car_bringup.robot_frames import fixed_frames, Frame, moving_frames, parse_joints
 from swivel_car_bringup.topics import message_class, subscription_qos, TopicWatcher
 from swivel_car_ros.ros_params import refuse_runtime_changes, run_node
 
@@ -38,18 +32,6 @@ PARAMETERS = {
     'port': (8765, 'WebSocket port'),
     'discovery_period': (0.5, 'how often the graph is searched for new topics [s] wall'),
 }
-FRAMES_TOPIC = '/robot_frames'
-LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
-
-
-def _foxglove_transform(frame: Frame, stamp) -> FrameTransform:
-    return FrameTransform(timestamp=Timestamp(sec=stamp.sec, nsec=stamp.nanosec),
-                          parent_frame_id=frame.parent, child_frame_id=frame.child,
-                          translation=Vector3(x=frame.translation[0], y=frame.translation[1],
-                                              z=frame.translation[2]),
-                          rotation=Quaternion(x=frame.rotation[0], y=frame.rotation[1],
-                                              z=frame.rotation[2], w=frame.rotation[3]))
 
 
 class _Latching(ServerListener):
@@ -89,12 +71,6 @@ class FoxgloveBridgeNode(Node):
             raise ValueError(f'cannot serve on {values["host"]}:{values["port"]}: {error}') \
                 from None
         self._channels: list[Channel] = []
-        self._frames = FrameTransformsChannel(FRAMES_TOPIC)
-        self._joints: list = []
-        self._static_frames: list[Frame] = []
-        self.create_subscription(String, 'robot_description', self._on_description, LATCHED)
-        self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10)
-        self.create_subscription(Odometry, 'odom', self._on_odom, 10)
         TopicWatcher(self, self._on_topic, values['discovery_period'])
         self.get_logger().info(f'Foxglove: open ws://{values["host"]}:{self._server.port}')
 
@@ -121,31 +97,6 @@ class FoxgloveBridgeNode(Node):
 
         self.create_subscription(msg_class, topic, forward, qos, raw=True)
         self.get_logger().info(f'serving {topic} ({type_name})')
-
-    def _on_description(self, msg: String) -> None:
-        try:
-            self._joints = parse_joints(msg.data)
-        except ValueError as error:
-            self.get_logger().error(f'robot_description is not a URDF ({error}): no link '
-                                    f'frames on {FRAMES_TOPIC}')
-            return
-        self._static_frames = fixed_frames(self._joints)
-
-    def _on_joint_states(self, msg: JointState) -> None:
-        frames = self._static_frames + moving_frames(self._joints,
-                                                     dict(zip(msg.name, msg.position)))
-        self._log_frames(frames, msg.header.stamp)
-
-    def _on_odom(self, msg: Odometry) -> None:
-        p, q = msg.pose.pose.position, msg.pose.pose.orientation
-        self._log_frames([Frame(msg.header.frame_id, msg.child_frame_id, (p.x, p.y, p.z),
-                                (q.x, q.y, q.z, q.w))], msg.header.stamp)
-
-    def _log_frames(self, frames: list[Frame], stamp) -> None:
-        if frames:
-            self._frames.log(
-                FrameTransforms(transforms=[_foxglove_transform(f, stamp) for f in frames]),
-                log_time=stamp.sec * 1_000_000_000 + stamp.nanosec)
 
     def destroy_node(self) -> None:
         self._server.stop()

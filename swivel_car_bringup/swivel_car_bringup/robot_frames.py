@@ -3,8 +3,8 @@ The frames of a URDF's links from joint positions, as robot_state_publisher comp
 
 One transform parent link -> child link per joint. ROS-free.
 
-Used where robot_state_publisher is not installed: by ``robot_description_node`` for /tf and
-/tf_static, and by the Foxglove bridge, which sends the frames to the 3D view itself.
+Used where robot_state_publisher is not installed, by ``robot_description_node`` for /tf and
+/tf_static.
 """
 
 from __future__ import annotations
@@ -132,3 +132,27 @@ def moving_frames(joints: list[Joint], positions: Mapping[str, float]) -> list[F
     """Return the frames of the moving joints named in ``positions`` (its /tf)."""
     return [joint_frame(j, positions[j.name]) for j in joints
             if j.kind in MOVING and j.name in positions]
+
+
+class RateLimit:
+    """
+    At most one publication per ``period`` [s] of message time.
+
+    As robot_state_publisher's publish_frequency limits /tf, but by the messages' stamps, not
+    a clock, so a lockstep sim gives the same publications every run. Time going back (a
+    restarted sim) starts again.
+    """
+
+    def __init__(self, period: float) -> None:
+        if not (isinstance(period, (int, float)) and math.isfinite(period) and period >= 0.0):
+            raise ValueError(f'the period must be a number >= 0 s, got {period!r}')
+        self._period = period  # [s]
+        self._last: float | None = None  # [s] message time of the last publication
+
+    def due(self, t: float) -> bool:
+        """Return whether a message of time ``t`` [s] is published (and count it if so)."""
+        # 1 ns of slack: stamps are whole nanoseconds, a period of 0.05 s is not in floats.
+        if self._last is None or t < self._last or t - self._last >= self._period - 1e-9:
+            self._last = t
+            return True
+        return False

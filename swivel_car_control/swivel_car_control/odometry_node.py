@@ -1,7 +1,8 @@
 """
 odometry_node: tricycle-with-variable-offset odometry from joint_states, on ``odom``.
 
-REP-105: odom -> base_link, twist in base_link.
+REP-105: odom -> base_link, twist in base_link; the same pose as the transform odom -> base_link
+on ``/tf``, as tf2_ros' TransformBroadcaster sends it (tf2_msgs/TFMessage, reliable, depth 100).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from typing import Any, ClassVar
 from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
+from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Empty
 from swivel_car_control.core.joint_states import (
@@ -28,6 +30,7 @@ from swivel_car_ros.ros_params import (
     STATE_QUEUE_DEPTH)
 from swivel_car_ros.serialized import (
     read_joint_state, read_logged, SerializedMessage, STAMP_FORMAT)
+from tf2_msgs.msg import TFMessage
 
 
 @dataclass(frozen=True)
@@ -80,7 +83,7 @@ CONFIG_DESCRIPTIONS = {
     'odom_frame_id': 'fixed frame of the odometry (header.frame_id)',
     'base_frame_id': 'robot frame (child_frame_id)',
     'tf_frame_prefix': 'prefix for both frame ids, e.g. a robot name; empty = none',
-    'enable_odom_tf': 'broadcast odom -> base_link on /tf (needs tf2_ros)',
+    'enable_odom_tf': 'broadcast odom -> base_link on /tf',
     'pose_covariance_diagonal': 'pose covariance diagonal x y z roll pitch yaw [m^2, rad^2]',
     'twist_covariance_diagonal': 'twist covariance diagonal [(m/s)^2, (rad/s)^2]',
     'swivel_joint': 'swivel joint name in joint_states',
@@ -114,7 +117,6 @@ class OdometryNode(Node):
         self._gated = GatedOdometry(joint_odometry, {
             config.swivel_joint: MAX_SWIVEL_RATE, config.rear_left_wheel_joint: max_wheel_rate,
             config.rear_right_wheel_joint: max_wheel_rate})
-        self._tf = self._make_tf_broadcaster() if config.enable_odom_tf else None
         # Built once, refilled every period: a message constructor imports and builds each
         # nested message in Python, every time; the odometry is rewritten in its CDR bytes.
         odom = Odometry(child_frame_id=config.frame(config.base_frame_id))
@@ -127,12 +129,20 @@ class OdometryNode(Node):
             ('<6d', tuple(f'twist.twist.linear.{c}' for c in 'xyz')
              + tuple(f'twist.twist.angular.{c}' for c in 'xyz')),
             ('<36d', ('twist.covariance',))))
-        self._transform = TransformStamped(child_frame_id=odom.child_frame_id)
-        self._transform.header.frame_id = odom.header.frame_id
+        transform = TransformStamped(child_frame_id=odom.child_frame_id)
+        transform.header.frame_id = odom.header.frame_id
+        self._transform = SerializedMessage(TFMessage(transforms=[transform]), (
+            (STAMP_FORMAT, ('transforms.0.header.stamp.sec', 'transforms.0.header.stamp.nanosec')),
+            ('<7d', tuple(f'transforms.0.transform.translation.{c}' for c in 'xyz')
+             + tuple(f'transforms.0.transform.rotation.{c}' for c in 'xyzw'))))
 
         self._apply_config(config)
         live_parameters(self, OdometryConfig.LIVE, self._live_config, self._apply_config)
         self._odom_pub = self.create_publisher(Odometry, 'odom', STATE_QUEUE_DEPTH)
+        # tf2_ros' DynamicBroadcasterQoS; the message is tf2_msgs' (the workspace builds it
+        # where the underlay has none), so no tf2_ros is needed.
+        self._tf_pub = self.create_publisher(TFMessage, '/tf', QoSProfile(depth=100)) \
+            if config.enable_odom_tf else None
         # Outside the lockstep chain the odometry may trail a busy sim: a second of states
         # queued, so it integrates every one instead of dropping them and Euler-stepping the
         # gap with the last rates.
@@ -155,18 +165,6 @@ class OdometryNode(Node):
         self._config = config
         self._odom.pack(2, *_diagonal(config.pose_covariance_diagonal))
         self._odom.pack(4, *_diagonal(config.twist_covariance_diagonal))
-
-    def _make_tf_broadcaster(self):
-        try:
-            from tf2_ros import TransformBroadcaster
-        except ImportError as error:
-            self.get_logger().warn(
-                f'tf2_ros is not importable ({error}): NOT broadcasting '
-                f'{self._config.frame(self._config.odom_frame_id)} -> '
-                f'{self._config.frame(self._config.base_frame_id)} on /tf; the pose is only '
-                'on the odom topic')
-            return None
-        return TransformBroadcaster(self)
 
     def _on_joint_states(self, data: bytes) -> None:
         msg = read_logged(self.get_logger(), read_joint_state, data, 'joint_states')
@@ -200,14 +198,11 @@ class OdometryNode(Node):
         msg.pack(1, odometry.x, odometry.y, 0.0, *orientation)
         msg.pack(3, odometry.v, 0.0, 0.0, 0.0, 0.0, odometry.omega)
         self._odom_pub.publish(msg.serialized())
-        if self._tf is not None:
-            transform = self._transform.transform
-            self._transform.header.stamp = stamp
-            transform.translation.x = odometry.x
-            transform.translation.y = odometry.y
-            rotation = transform.rotation
-            rotation.x, rotation.y, rotation.z, rotation.w = orientation
-            self._tf.sendTransform(self._transform)
+        if self._tf_pub is not None:
+            transform = self._transform
+            transform.pack(0, stamp.sec, stamp.nanosec)
+            transform.pack(1, odometry.x, odometry.y, 0.0, *orientation)
+            self._tf_pub.publish(transform.serialized())
 
     def _on_reset(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
         self._odometry.reset()

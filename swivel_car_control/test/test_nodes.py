@@ -22,6 +22,7 @@ from swivel_car_control.odometry_node import OdometryNode
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import SetPose2D
 from swivel_car_testing import next_domain_id, spin_until
+from tf2_msgs.msg import TFMessage
 
 JOINTS = ['swivel_joint', 'rear_left_wheel_joint', 'rear_right_wheel_joint',
           'front_left_wheel_joint', 'front_right_wheel_joint']
@@ -428,6 +429,24 @@ def test_odometry_straight_frames_reset_and_set_pose(odometry):
     assert not bad.success and 'finite' in bad.message
     odom = feed(odometry, 2.73, 0.1)
     assert odom.pose.pose.position.x == pytest.approx(1.0)
+
+
+def test_odometry_tf_is_its_odom_pose_in_the_prefixed_frames(odometry):
+    tf = odometry.record(TFMessage, '/tf')
+    spin_until(odometry.executor, lambda: odometry.node.count_subscribers('/tf') > 0, 10.0,
+               '/tf matched')
+    odom = feed(odometry, 1.0, 1.0, wheel_rate=2.0, swivel=0.3)
+    spin_until(odometry.executor, lambda: tf and tf[-1].transforms[0].header.stamp
+               == odom.header.stamp, 10.0, '/tf of the last odom')
+    (transform,) = tf[-1].transforms
+    assert (transform.header.frame_id, transform.child_frame_id) == (
+        'robot1/odom', 'robot1/base_link')
+    p, q = transform.transform.translation, transform.transform.rotation
+    pose = odom.pose.pose
+    assert (p.x, p.y, p.z) == (pose.position.x, pose.position.y, pose.position.z)
+    assert (q.x, q.y, q.z, q.w) == (pose.orientation.x, pose.orientation.y,
+                                    pose.orientation.z, pose.orientation.w)
+    assert pose.position.y != 0.0  # the swivel turned the car: every field was written
 
 
 def test_odometry_covariances_set_live_reach_the_next_odom(odometry):

@@ -115,6 +115,10 @@ def read_joint_state(data: bytes) -> JointStateView:
     return JointStateView(stamp, tuple(names), *arrays)
 
 
+def _field(parent, name: str):
+    return parent[int(name)] if name.isdigit() else getattr(parent, name)
+
+
 class SerializedMessage:
     """
     A message serialized once, whose changing fields are rewritten in place.
@@ -125,9 +129,9 @@ class SerializedMessage:
         The message with its constant fields (frame ids, names) set.
     fields : tuple of (str, tuple of str)
         Groups of fields consecutive in the serialized message, each a struct format and the
-        fields' dotted paths, rewritten with ``pack(index of the group, *values)``. A
-        float64[] field is a group of one path and the format ``'<Nd'``: its length N is
-        fixed from then on.
+        fields' dotted paths (a number is an element of a sequence: 'transforms.0.header'),
+        rewritten with ``pack(index of the group, *values)``. A float64[] field is a group of
+        one path and the format ``'<Nd'``: its length N is fixed from then on.
 
     """
 
@@ -143,7 +147,7 @@ class SerializedMessage:
             for path, value in zip(paths, [values] if len(paths) < count else values,
                                    strict=True):
                 *parents, name = path.split('.')
-                setattr(reduce(getattr, parents, msg), name, value)
+                setattr(reduce(_field, parents, msg), name, value)
             expected.append((layout, layout.pack(*values)))
         self._data = bytearray(serialize_message(msg))
         self._groups = []
