@@ -1,19 +1,14 @@
 """
-The planner node: climb_step as a service and as an action, one shared climb.
+The planner node: climb_step as a service and as an action, one shared climb (``ClimbSlot``).
 
-The core's ``ClimbStateMachine`` steps once per controller state, on the inputs of that
-moment (``core.sync``), and the command it answers carries that moment's stamp: in a lockstep
-sim the controller applies it exactly one cycle later (its ``lockstep_swivel_command``), so a
-climb does not depend on how busy the machine is. It runs on the EventsExecutor (a message
-in about a quarter of a SingleThreadedExecutor's time), and nothing waits for a climb in a
-callback or a task: a request starts the planning, the planning's end starts the climb, the
-climb's end answers (the service's callback returns a future of its response, sent once that
-completes; an action goal executes only then, to report the result). A coroutine waiting for
-the climb would cost CPU all along: the EventsExecutor resumes every waiting task after each
-message, and spun one callback at a time (``run_node``) it resumes them again at once, a busy
-loop. Planning takes seconds of CPU when a backup is searched: it runs on a worker thread,
-which hands its result to the executor as a task (``create_task`` wakes it from any thread; the
-EventsExecutor has no guard conditions).
+A thin adapter of the core: the ``ClimbStateMachine`` steps once per controller state, on the
+inputs of that moment (``core.sync``), and the command it answers carries that moment's stamp:
+in a lockstep sim the controller applies it exactly one cycle later, so a climb does not
+depend on how busy the machine is. ``InputLiveness`` says when the inputs count as alive.
+Nothing waits for a climb in a callback or a task (on the EventsExecutor a waiting coroutine
+is resumed after every message): a request starts the planning, on a worker thread (seconds
+of CPU when a backup is searched); the planning's end starts the climb; the climb's end
+answers (the service's response, an action goal's execution).
 """
 
 from __future__ import annotations
@@ -47,6 +42,7 @@ from swivel_car_planner.conversions import (
 from swivel_car_planner.core import (
     capability, ClimbPlan as Plan, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs,
     make_plan, PlanError, PlannerConfig, validate_request)
+from swivel_car_planner.core.liveness import ClimbSlot, InputLiveness
 from swivel_car_planner.core.sync import InputSync, Tick
 from swivel_car_ros.lockstep import ChainEntry, Entry
 from swivel_car_ros.ros_params import (
@@ -95,16 +91,18 @@ class _Result:
         return message
 
 
-class _AnsweredLater(Service):
+def _answer_later(service: Service) -> None:
     """
-    A service whose callback returns a Future of its response, sent once that completes.
+    Make ``service`` send what its callback returns, a Future of the response, once done.
 
-    Both executors send what a service callback returns through ``send_response``.
+    rclpy has no deferred service response (rclcpp has had one since Humble), and Jazzy's
+    EventsExecutor takes no coroutine as a service callback (it hands the coroutine itself to
+    ``send_response``): both executors send what the callback returns through the service's
+    ``send_response``, and this one waits for the Future first.
     """
-
-    def send_response(self, response: Future, header) -> None:
-        response.add_done_callback(
-            lambda done: Service.send_response(self, done.result(), header))
+    send = service.send_response
+    service.send_response = lambda answered, header: answered.add_done_callback(
+        lambda done: send(done.result(), header))
 
 
 class _PlanWorker:
@@ -169,21 +167,12 @@ class PlannerNode(Node):
             'ready_timeout', 1.0, 'inputs older than this (in sim and wall time) mean not '
                                   'ready; a climb whose inputs stop for this long aborts [s]')
 
-        self._climb: _ActiveClimb | None = None
-        self._planning = False  # a climb's plan is being made (the climb slot is taken)
+        self._slot: ClimbSlot[_ActiveClimb] = ClimbSlot()
         self._resets = 0  # sim/reset_events heard
         self._plans = _PlanWorker(self)
-        # topic -> (sim time [s], steady clock [s]) of its last message
-        self._received: dict[str, tuple[float, float]] = {}
-        self._clock_last = -math.inf  # [s] the node clock at the last input heard
-        self._clock_moved_wall = -math.inf  # [s] steady clock when an input last saw it move
+        self._liveness = InputLiveness(_INPUTS, self._ready_timeout)
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
         self._refusals = inputs.RefusalLog(5.0)  # [s] as read_logged's lines
-        self._last_tick = 0.0  # [s] node clock when the running climb last had a tick
-        self._last_tick_wall = 0.0  # [s] steady clock then
-        self._last_tick_stamp = -math.inf  # [s] the stamp of the climb's last engaged tick
-        self._quiet_checks = 0  # input checks in a row that saw no tick
-        self._quiet_wall_checks = 0
 
         # Serialized: the planner reads a few fields of each (conversions.odom_fields).
         self.create_subscription(Odometry, 'odom', self._on_odom, 10, raw=True)
@@ -192,16 +181,14 @@ class PlannerNode(Node):
                                  self._on_controller_state, 10, raw=True)
         self.create_subscription(Header, 'sim/reset_event', self._on_sim_reset, 10)
         self._command_pub = self.create_publisher(SwivelCommand, 'swivel_command', 10)
-        self.create_service(ClimbStepService, 'climb_step',
-                            self._on_service).__class__ = _AnsweredLater
+        _answer_later(self.create_service(ClimbStepService, 'climb_step', self._on_service))
         self._action = ActionServer(
             self, ClimbStepAction, 'climb_step', execute_callback=self._on_execute,
             goal_callback=self._on_goal, cancel_callback=self._on_cancel,
             handle_accepted_callback=self._on_accepted)
         self._goal_results: dict[bytes, _Result] = {}  # goal id -> the result of its climb
-        self.create_timer(self._ready_timeout / 4.0, self._check_inputs_alive)
         # A dead sim stops /clock, and with it every sim-time timer: this one is not stopped.
-        self.create_timer(self._ready_timeout / 4.0, self._check_sim_alive,
+        self.create_timer(self._ready_timeout / 4.0, self._check_alive,
                           clock=Clock(clock_type=ClockType.STEADY_TIME))
         # The model's swivel drift is integrated once per robot (0.3 s of CPU); done now, the
         # first climb's planning does not take that much longer.
@@ -304,45 +291,12 @@ class PlannerNode(Node):
         A climb starts from the inputs heard after its planning (``_planned``), so none is
         kept before.
         """
-        now, wall = self._now(), time.monotonic()
-        self._received[topic] = (now, wall)
-        if now != self._clock_last:
-            self._clock_last, self._clock_moved_wall = now, wall
-        return self._climb is not None
-
-    def _clock_stands(self) -> bool:
-        """Tell whether the inputs have seen the node clock stand still for ready_timeout."""
-        return time.monotonic() - self._clock_moved_wall > self._ready_timeout
+        self._liveness.heard(topic, self._now(), time.monotonic())
+        return self._slot.climb is not None
 
     def _add(self, topic: str, stamp: TimeMsg, value: tuple) -> None:
         for tick in self._sync.add(topic, stamp_to_seconds(stamp), value):
             self._on_tick(tick)
-
-    def _missing_inputs(self, wall_too: bool = False) -> list[str]:
-        """
-        List the inputs not heard within ``ready_timeout`` of sim time (all, before /clock).
-
-        ``wall_too``: only those not heard within ``ready_timeout`` of wall time either (for a
-        request). Out of a climb the planner is outside the lockstep chain and the sim races
-        ahead of it: a planner not scheduled for a tenth of a second then takes the newest
-        /clock first (its subscription keeps only that one) and the inputs of the same moments
-        after it, from their queues, which look a second old in sim time though they came
-        milliseconds ago (seen on a loaded machine: the clock leapt 1.15 s ahead of them in
-        0.13 s of wall time, and a request then was refused on a running stack). An input that
-        has stopped is silent on both clocks. A clock that stands still (a sim gone, or one
-        restarted but unheard) keeps every input fresh in sim time: then wall time alone tells.
-        """
-        now, wall = self._now(), time.monotonic()
-        timeout = self._ready_timeout
-        clock_stands = self._clock_stands()
-
-        def silent(topic: str) -> bool:
-            sim, steady = self._received[topic]
-            return (now - sim > timeout or clock_stands) and \
-                (not wall_too or wall - steady > timeout)
-
-        return [topic for topic in _INPUTS
-                if now <= 0.0 or topic not in self._received or silent(topic)]
 
     # --- the climb ------------------------------------------------------------------------
 
@@ -354,19 +308,14 @@ class PlannerNode(Node):
             answer(self._failure(code, message))
             return
         if not request.plan_only:
-            missing = self._missing_inputs(wall_too=True)
-            if missing:
-                question = (f'sim time has stood at {self._now():.2f} s: is the sim running, '
-                            f'not paused?' if self._clock_stands() else
-                            'are the sim, controller and odometry running?')
-                answer(self._failure(ErrorCode.NOT_READY,
-                                     f'no recent message on {", ".join(missing)}: {question}'))
+            not_ready = self._liveness.not_ready(self._now(), time.monotonic())
+            if not_ready is not None:
+                answer(self._failure(ErrorCode.NOT_READY, not_ready))
                 return
-            if self._busy():
+            if not self._slot.take():
                 answer(self._failure(ErrorCode.BUSY,
                                      'a climb is already being planned or running'))
                 return
-            self._planning = True
         resets = self._resets
 
         def planned(future: Future) -> None:
@@ -382,7 +331,7 @@ class PlannerNode(Node):
                  goal_handle: ServerGoalHandle | None) -> _Result | None:
         """Return the result of a finished planning; None when the climb has started."""
         if not request.plan_only:
-            self._planning = False
+            self._slot.planned(None)
         try:
             plan = planned.result()
         except PlanError as error:
@@ -402,47 +351,26 @@ class PlannerNode(Node):
         # The climb starts from the moments after its planning (seconds, when a backup is
         # searched): a tick of the inputs collected before would be that old.
         self._sync.clear()
-        self._climb = climb
-        self._last_tick = self._now()
-        self._last_tick_wall = time.monotonic()
-        self._last_tick_stamp = -math.inf
-        self._quiet_checks = self._quiet_wall_checks = 0
+        self._slot.planned(climb)
+        self._liveness.climb_started(self._now(), time.monotonic())
         self.get_logger().info(
             f'climbing a {request.step_height:.3f} m step {request.step_distance:.2f} m ahead: '
             f'swivel {plan.swivel_angle:.3f} rad, approach heading '
             f'{plan.approach_heading:.3f} rad')
         return None
 
-    def _busy(self) -> bool:
-        return self._planning or self._climb is not None
-
     def _failure(self, code: ErrorCode, message: str) -> _Result:
         self.get_logger().warning(f'climb_step refused ({code.name}): {message}')
         return _Result(False, int(code), message, ClimbPlan(), ClimbOutcome())
 
     def _on_tick(self, tick: Tick) -> None:
-        climb = self._climb
+        climb = self._slot.climb
         if climb is None:
             return
-        if tick.time < self._last_tick_stamp:
-            self._abort(climb, tick.time, ErrorCode.NOT_READY,
-                        f'time went back from {self._last_tick_stamp:.2f} s to '
-                        f'{tick.time:.2f} s (a restarted sim?): the climb does not go on in '
-                        f'another world')
+        failure = self._liveness.tick(tick.time, self._now(), time.monotonic())
+        if failure is not None:
+            self._abort(climb, failure[0], ErrorCode.NOT_READY, failure[1])
             return
-        if math.isfinite(self._last_tick_stamp) \
-                and tick.time - self._last_tick_stamp > self._ready_timeout:
-            # Engaged, consecutive states are a control period apart: a leap is a bad stamp,
-            # a clock that jumped or a planner the controller gave up waiting for, and acting
-            # on it would time out or steer on a lie.
-            self._abort(climb, self._last_tick_stamp, ErrorCode.NOT_READY,
-                        f'the inputs leapt from {self._last_tick_stamp:.2f} s to '
-                        f'{tick.time:.2f} s, more than ready_timeout ({self._ready_timeout} '
-                        f's): not acted on')
-            return
-        self._last_tick = self._now()
-        self._last_tick_wall = time.monotonic()
-        self._quiet_checks = self._quiet_wall_checks = 0
         entry = climb.entry.state(tick.time, inputs.command_heard(tick))
         if entry is Entry.REPEAT:
             self._publish_command(climb.first_command, tick.time)
@@ -455,7 +383,7 @@ class PlannerNode(Node):
                 f'the controller heard the first command of {climb.entry.first:.2f} s only at '
                 f'{tick.time:.2f} s: the climb starts from there')
         if climb.entry.engaged:
-            self._last_tick_stamp = tick.time
+            self._liveness.engaged(tick.time)
         if climb.goal_handle is not None and climb.goal_handle.is_cancel_requested:
             climb.machine.cancel()
         command = climb.machine.update(inputs.observation(tick))
@@ -467,45 +395,14 @@ class PlannerNode(Node):
         if climb.machine.outcome is not None:
             self._end(climb, tick.time)
 
-    def _check_inputs_alive(self) -> None:
-        """
-        End a climb whose inputs stopped (odometry or controller gone).
-
-        The controller's swivel_command deadman has stopped the car by then.
-        Only after two checks in a row without a tick: after the executor was held up (a
-        loaded machine), this timer runs before the queued inputs and would see a stale tick.
-        """
-        climb = self._climb
-        if climb is None or not climb.entry.engaged:
-            return  # the sim is not held back for the planner yet: sim time may race
-        self._quiet_checks += 1
-        now = self._now()
-        if self._quiet_checks < 2 or now - self._last_tick <= self._ready_timeout:
-            return
-        missing = ', '.join(self._missing_inputs()) or 'none'
-        self._abort(climb, now, ErrorCode.NOT_READY,
-                    f'no complete input for {now - self._last_tick:.1f} s of sim time at '
-                    f'{now:.2f} s; missing: {missing}; {self._sync.describe()}')
-
-    def _check_sim_alive(self) -> None:
-        """
-        End a climb whose sim died (or was paused) after ``ready_timeout`` of wall time.
-
-        That is, without a tick: sim time stands still then, so the sim-time check never
-        fires.
-        """
-        climb = self._climb
-        if climb is None:
-            return
-        self._quiet_wall_checks += 1
-        quiet = time.monotonic() - self._last_tick_wall  # [s] wall
-        if self._quiet_wall_checks < 2 or quiet <= self._ready_timeout:
-            return
-        now = self._now()
-        self._abort(climb, now, ErrorCode.NOT_READY,
-                    f'no complete input for {quiet:.1f} s of wall time while sim time went '
-                    f'from {self._last_tick:.2f} s to {now:.2f} s: is the sim running (not '
-                    f'paused)? {self._sync.describe()}')
+    def _check_alive(self) -> None:
+        """End a climb whose inputs stopped (``InputLiveness.check``): the deadman stopped it."""
+        climb = self._slot.climb
+        if climb is not None:
+            failure = self._liveness.check(self._now(), time.monotonic(), climb.entry.engaged,
+                                           self._sync.describe)
+            if failure is not None:
+                self._abort(climb, failure[0], ErrorCode.NOT_READY, failure[1])
 
     def _on_sim_reset(self, msg: Header) -> None:
         """
@@ -516,7 +413,7 @@ class PlannerNode(Node):
         the drive stopped; the usual stop would hold the swivel at the old world's angle.
         """
         self._resets += 1
-        climb = self._climb
+        climb = self._slot.climb
         if climb is None:
             return
         stamp = stamp_to_seconds(msg.stamp)  # [s]
@@ -537,7 +434,7 @@ class PlannerNode(Node):
 
         The last command holds it; the controller keeps holding it, and cmd_vel steers again.
         """
-        self._climb = None
+        self._slot.end()
         outcome = climb.machine.outcome
         for command in inputs.end_commands(outcome):
             self._publish_command(command, stamp)
@@ -578,7 +475,7 @@ class PlannerNode(Node):
         return answered
 
     def _on_goal(self, goal) -> GoalResponse:
-        if self._busy() and not goal.plan_only:
+        if self._slot.busy and not goal.plan_only:
             self.get_logger().warning(
                 'climb_step goal rejected: a climb is already being planned or running')
             return GoalResponse.REJECT
