@@ -19,7 +19,8 @@ import os
 from hypothesis import settings
 
 for package in ('swivel_car_bringup', 'swivel_car_control', 'swivel_car_model',
-                'swivel_car_planner', 'swivel_car_ros', 'swivel_car_sim'):
+                'swivel_car_perception', 'swivel_car_planner', 'swivel_car_ros',
+                'swivel_car_sim'):
     importlib.import_module(package)
 
 settings.register_profile('deterministic', derandomize=True, deadline=None)

@@ -22,13 +22,15 @@ from rclpy.action import get_action_server_names_and_types_by_node
 from rclpy.node import Node
 from swivel_car_control.controller_node import ControllerNode
 from swivel_car_control.odometry_node import OdometryNode
+from swivel_car_perception.step_detector_node import StepDetectorNode
 from swivel_car_planner.planner_node import PlannerNode
 from swivel_car_sim.sim_node import SimNode
 
 BEGIN, END = '<!-- node tables: begin (scripts/node_docs.py) -->', '<!-- node tables: end -->'
 NODES = (('swivel_car_sim', 'sim_node', SimNode), ('swivel_car_control', 'controller_node',
          ControllerNode), ('swivel_car_control', 'odometry_node', OdometryNode),
-         ('swivel_car_planner', 'planner_node', PlannerNode))
+         ('swivel_car_planner', 'planner_node', PlannerNode),
+         ('swivel_car_perception', 'step_detector_node', StepDetectorNode))
 # Every node has these; `ros2 param` documents them.
 STANDARD_SERVICES = {'describe_parameters', 'get_parameter_types', 'get_parameters',
                      'get_type_description', 'list_parameters', 'set_parameters',

@@ -15,6 +15,7 @@ from swivel_car_control.controller_node import ControllerNode
 from swivel_car_control.odometry_node import OdometryNode
 from swivel_car_model import description
 from swivel_car_model.description import CarDescription
+from swivel_car_perception.step_detector_node import StepDetectorNode
 from swivel_car_planner.planner_node import PlannerNode
 from swivel_car_sim.sim_node import SimNode
 from swivel_car_stack import config_path
@@ -23,7 +24,8 @@ from swivel_car_testing import next_domain_id
 NODES = [(SimNode, 'swivel_car_sim', 'sim_node.yaml'),
          (ControllerNode, 'swivel_car_control', 'controller_node.yaml'),
          (OdometryNode, 'swivel_car_control', 'odometry_node.yaml'),
-         (PlannerNode, 'swivel_car_planner', 'planner_node.yaml')]
+         (PlannerNode, 'swivel_car_planner', 'planner_node.yaml'),
+         (StepDetectorNode, 'swivel_car_perception', 'step_detector_node.yaml')]
 
 
 def _node(node_class, package, config, overrides=()):
@@ -68,6 +70,10 @@ def test_each_node_builds_its_cores_from_one_override():
                 assert node._core.config.max_torque == 25.0
             elif node_class is OdometryNode:
                 assert node._car == changed.model_params()
+            elif node_class is StepDetectorNode:
+                # The camera sits on the central body, which body_offset moves.
+                assert tuple(node._mount.position) == tuple(changed.camera_mount()[0])
+                assert node._mount.front_axle == changed.wheelbase
             else:
                 assert node.robot == changed.model_params()
                 assert node.description == changed

@@ -1,5 +1,5 @@
 """
-The whole stack: sim, controller, odometry, planner and the robot on the graph.
+The whole stack: sim, controller, odometry, planner, step detector and the robot on the graph.
 
 Optionally a recording and a live view (for a full Jazzy install with launch_ros).
 
@@ -61,6 +61,7 @@ def generate_launch_description() -> LaunchDescription:
             'sensor_profile': LaunchConfiguration('sensor_profile')}),
         _include('swivel_car_control', 'control.launch.py', sim_time_argument),
         _include('swivel_car_planner', 'planner.launch.py', sim_time_argument),
+        _include('swivel_car_perception', 'perception.launch.py', sim_time_argument),
         Node(package='swivel_car_bringup', executable='robot_description_node',
              name='robot_description', output='screen',
              parameters=[{**use_sim_time, 'robot_variant': ParameterValue(

@@ -75,6 +75,9 @@ CAMERA_OPTICAL_FRAME = 'camera_depth_optical_frame'
 # ahead of the front axle. Its housing is left out of the mass layout (72 g against 21 kg).
 CAMERA_PITCH = 0.35  # [rad] optical axis below base_link's x axis
 CAMERA_CLEARANCE = 0.015  # [m] lens ahead of and above the body's box
+# The optical frame's axes (REP 103: x right, y down, z forward) as columns in camera_link
+# (x forward, y left, z up).
+OPTICAL_IN_CAMERA_LINK = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
 
 
 def described(default: Any, description: str) -> Any:
@@ -236,6 +239,21 @@ class CarDescription:
         position = self.apex + np.array([self.body_offset + size[0] / 2.0 + CAMERA_CLEARANCE,
                                          0.0, size[2] / 2.0 + CAMERA_CLEARANCE])
         return position, CAMERA_PITCH
+
+    def camera_optical_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Return the depth camera's optical frame in base_link at rest.
+
+        Returns
+        -------
+        (origin [m], axes [1]): the optical x (right), y (down) and z (forward) axes as the
+        columns of a rotation matrix.
+
+        """
+        position, pitch = self.camera_mount()
+        c, s = math.cos(pitch), math.sin(pitch)
+        pitched = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+        return position, pitched @ OPTICAL_IN_CAMERA_LINK
 
     def wheel_centres(self) -> list[np.ndarray]:
         """

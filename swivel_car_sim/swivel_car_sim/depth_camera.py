@@ -131,15 +131,6 @@ class Intrinsics:
         return [self.fx, 0.0, self.cx, 0.0, self.fy, self.cy, 0.0, 0.0, 1.0]
 
 
-def _rotation_y(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-# Optical axes (x right, y down, z forward) in camera_link (x forward, y left, z up).
-OPTICAL_IN_CAMERA_LINK = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
-
-
 class DepthCamera:
     """
     Render depth images from the camera on the car.
@@ -164,10 +155,8 @@ class DepthCamera:
                  noise: StereoDepthNoise | None = StereoDepthNoise(), seed: int = 0) -> None:
         self._client = client
         self.intrinsics = Intrinsics.of(width, height)
-        position, pitch = description.camera_mount()
-        self._mount_position = position  # [m] in base_link
-        # Optical axes in base_link: columns x right, y down, z forward.
-        self.optical_in_base = _rotation_y(pitch) @ OPTICAL_IN_CAMERA_LINK
+        # The optical centre [m] and axes (columns x right, y down, z forward) in base_link.
+        self._mount_position, self.optical_in_base = description.camera_optical_pose()
         self.noise = noise
         self._seed = seed
         self._far = noise.max_range if noise is not None else StereoDepthNoise().max_range
