@@ -47,8 +47,8 @@ def test_executable_installed_and_starts(ros_domain, package, executable):
     assert path.stat().st_mode & 0o111, f'{path} is not executable'
     # The node is named after its executable (sim_node: 'sim'), in a namespace of this test's
     # own: the domain ids come round again, and a node of that name killed by an earlier test
-    # stays in the graph for seconds. Seen in it, it ended the wait while this one still
-    # imported, and SIGINT then ended the import with a traceback.
+    # stays in the graph for seconds; seen there, it would end the wait while this one still
+    # imports, and SIGINT would then end the import with a traceback.
     namespace = f'/executable_test_{os.getpid()}_{next(_STARTS)}'
     process = NodeProcess(package, executable, domain_id,
                           extra_args=('--ros-args', '-r', f'__ns:={namespace}'))

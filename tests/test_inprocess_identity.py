@@ -19,9 +19,9 @@ same sequence of calls. What the lockstep does not determine:
   in-process stack settles to that tick's time and climbs from it;
 - the odometry before the climb: outside the chain nothing waits for it, so it may start
   after the sim's first states or, under load, fall more than its queue behind the unpaced sim
-  and integrate fewer, longer steps (measured: 851 of 1221 states skipped; without the reset
-  the runs then differed from about 1 s into the climb, drive_speed by 1e-15 rad/s). Both
-  runs reset it to the origin at the paused moment, once it has integrated that state.
+  and integrate fewer, longer steps (most of them, under load; without the reset the runs
+  differ from about 1 s into the climb, drive_speed by 1e-15 rad/s). Both runs reset it to
+  the origin at the paused moment, once it has integrated that state.
 """
 
 from __future__ import annotations
@@ -61,9 +61,9 @@ class _Recorder:
     """
     Ground truth, joint positions, actuator commands and odometry of the ROS run, by stamp.
 
-    Kept serialized, read when compared: deserializing on receipt made this node, outside the
-    chain, trail the unpaced sim by more than the sim's writers keep (100 messages), and it
-    lost 22 and 108 states in a row (2 of about 20 loaded runs).
+    Kept serialized, read when compared: deserializing on receipt, this node, outside the
+    chain, trails a loaded, unpaced sim by more than the sim's writers keep (100 messages) and
+    loses states.
     """
 
     def __init__(self, session: SimSession) -> None:
@@ -108,10 +108,10 @@ class _Recorder:
         """
         Return which of ``times`` [s] were recorded in every stream, and their values.
 
-        The sim's writers keep 100 messages each: this node, outside the chain, still lost
-        13 of 1040 ground truths once on a loaded CI run (scattered over 0.2 s) even reading
-        them serialized. The periods it has are compared bit for bit; it must have at least
-        ``MIN_RECORDED`` of them, the first and the last among them.
+        The sim's writers keep 100 messages each: this node, outside the chain, can still
+        lose a few on a loaded machine even reading them serialized. The periods it has are
+        compared bit for bit; it must have at least ``MIN_RECORDED`` of them, the first and
+        the last among them.
         """
         streams = (self.truth, self.joints, self.commands)
         recorded = np.array([all(t in stream for stream in streams) for t in times])

@@ -1,8 +1,8 @@
 """
 The command-line scripts under scripts/ import and parse their arguments.
 
-`make soak` once failed at start: scripts/soak.py imported a helper that had moved out of
-scripts/demo.py, and no test imported it.
+Nothing else imports them: a helper moved out of one script would break another that imports
+it only when that script runs (`make soak`, say).
 """
 
 import importlib

@@ -48,7 +48,7 @@ class Driver:
 
     Only once the odometry has published that moment too: the controller waits for this
     driver's cmd_vel (lockstep_cmd_vel), so the odometry, outside the chain, never falls
-    behind the sim (a loaded one once lost 0.43 m of this run).
+    behind the sim (a loaded one lagging more than its queue would lose part of this run).
     """
 
     def __init__(self, context):

@@ -14,7 +14,7 @@ its cmd_vel are stamped with the state they answer and the controller waits for 
 lockstep chain of docs/architecture.md, with ``lockstep_cmd_vel``), so the routes are
 deterministic and the sim runs unpaced. The driver answers a state only once the odometry
 has published it too, so the odometry, outside the chain, never falls behind: a loaded one
-once lagged more than the joint_states kept for it and lost 0.43 m of a straight route.
+lagging more than the joint_states kept for it would lose part of a route.
 """
 
 from __future__ import annotations

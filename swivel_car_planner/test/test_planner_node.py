@@ -240,9 +240,9 @@ def test_a_clock_standing_still_keeps_no_silent_input_fresh(rig):
     """
     Check a silent input counts as gone on wall time alone while the clock stands still.
 
-    Seen on a stack: the planner never heard a restarted sim (a middleware defect, see
-    tests/test_stack.py), so its clock stood at the old sim's last moment and the old sim's
-    last imu looked fresh in sim time; a climb was accepted and aborted a second later.
+    A planner that does not hear a restarted sim (see tests/test_stack.py) has its clock
+    standing at the old sim's last moment, where the old sim's last imu looks fresh in sim
+    time: a climb would be accepted and aborted a second later.
     """
     rig.warm_up()
     start = time.monotonic()
@@ -450,7 +450,7 @@ def test_a_sim_running_ahead_of_the_first_command_does_not_end_the_climb(rig):
     Check the planner repeats its first command until the controller has heard it.
 
     Until then the controller does not wait for the planner, so a loaded planner may hear
-    its next state seconds later (seen on a loaded CI machine); only from then on is a leap
+    its next state seconds later (on a loaded machine); only from then on is a leap
     a fault.
     """
     rig.warm_up()

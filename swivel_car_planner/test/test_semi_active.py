@@ -77,7 +77,7 @@ def test_a_swivel_stuck_against_the_riser_is_a_stall_not_no_progress():
 
 def test_the_approach_reaches_the_lift_point_aligned_despite_the_swivels_yaw():
     # For phi < 0 turning the swivel yaws the car against its turn (0.22 rad at 0.55 rad):
-    # steered on the bare heading, the approach overshot by 0.25 rad in the sim.
+    # steered on the bare heading, the approach overshoots by 0.25 rad in the sim.
     machine, plan, car = start()
     run_until(machine, car, lambda m, c: m.step == Step.PRESS)
     heading = machine.climb.edge.relative_heading(car.odometry.yaw)
@@ -86,7 +86,7 @@ def test_the_approach_reaches_the_lift_point_aligned_despite_the_swivels_yaw():
 
 def test_an_approach_far_off_its_line_turns_in_early_enough_to_lift_aligned():
     # A wide face, its crossing clamped to the face's end: the car holds its heading, then
-    # turns 0.75 rad onto the line. At crossing_gain alone it met the line still turning
+    # turns 0.75 rad onto the line. At crossing_gain alone it meets the line still turning
     # (0.26-0.41 rad off at the lift point in the sim).
     request = ClimbRequest(HEIGHT, 2.4, 0.0, step_width=4.0)
     plan = make_plan(P, CONFIG, request)

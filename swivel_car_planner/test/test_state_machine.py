@@ -96,10 +96,10 @@ def test_the_climb_ends_only_once_the_car_stands_on_top():
 
 
 def test_a_car_still_tipping_when_its_wheels_stop_is_not_called_on_top():
-    # Measured in the sim (0.09 m steps): a rear wheel rode up onto the riser's corner and
-    # rolled back. Odometry (its wheel had spun) put it 0.2 m past the edge, and the wheels
-    # stopped just as the rocking car passed level (roll 0.03 rad); the IMU then showed it
-    # rolling on at 0.4 rad/s to 0.13 rad, where it came to rest on the corner.
+    # As in the sim on 0.09 m steps: a rear wheel rides up onto the riser's corner and rolls
+    # back; odometry (its wheel spinning) puts it 0.2 m past the edge, and the wheels stop just
+    # as the rocking car passes level (roll 0.03 rad); the IMU then shows it rolling on at
+    # 0.4 rad/s to 0.13 rad, where it comes to rest on the corner.
     machine, _ = start()
     car = car_before()
     run(machine, car, until=lambda m, c: m.step == Step.STOP_ON_TOP)
@@ -116,8 +116,8 @@ def test_a_car_still_tipping_when_its_wheels_stop_is_not_called_on_top():
 
 
 def test_wheels_spinning_against_the_riser_are_not_a_climb():
-    # Measured (24-26 cm, the front never up): the car stayed level while odometry counted
-    # the spinning wheels as travel past the edge; it was called "climbed".
+    # As in the sim at 24-26 cm (the front never up): the car stays level while odometry
+    # counts the spinning wheels as travel past the edge.
     machine, _ = start()
     car = KinematicCar()  # no step: level all the way
     run(machine, car)

@@ -29,10 +29,8 @@ T = TypeVar('T')
 # State messages kept on both ends (publisher history, subscription queue): joint_states, so
 # that a node outside the lockstep chain (the odometry) that lags behind an unpaced sim skips no
 # state, and what a recorder or a test watches (ground truth, odom, actuator commands,
-# controller states: a test's recorder under load once missed 22 ground truths in a row, with
-# 10 kept): 1 s of the default control period. With 10 s, one full test run had whole-stack
-# tests stall on service calls (cause not found; Fast DDS keeps a writer's history in a 512 KiB
-# shared-memory segment).
+# controller states; 10 kept are too few for a recorder under load): 1 s of the default control
+# period. Not more: Fast DDS keeps a writer's history in a 512 KiB shared-memory segment.
 STATE_QUEUE_DEPTH = 100
 
 
@@ -163,7 +161,7 @@ def run_node(node_class: type[Node], name: str, args: list[str] | None = None,
         # Only noted: the loop ends after the callback in progress, on a context still up.
         # rclpy's own handlers shut the context down from their thread under a running
         # callback, whose publish then fails, and a KeyboardInterrupt raised in a callback
-        # fails it too; the EventsExecutor logs either as FATAL with a stack (seen on SIGTERM).
+        # fails it too; the EventsExecutor logs either as FATAL with a stack (SIGTERM included).
         # A second signal interrupts as usual: a stuck shutdown (a bag's close) still ends.
         signals.append(signum)
         signal.signal(signal.SIGINT, signal.default_int_handler)

@@ -16,7 +16,7 @@ command, the way an operator would push the stick further. The bias carries from
 while they want the same angle.
 
 The heading always comes from the IMU, the position from odometry: the wheels skid when the
-swivel turns at a standstill, and odometry's heading then drifts (0.3 rad seen in the sim).
+swivel turns at a standstill, and odometry's heading then drifts (up to 0.3 rad in the sim).
 """
 
 from __future__ import annotations
@@ -672,7 +672,7 @@ class StopOnTop(StepBehaviour):
     ``settle_time``. Odometry's speed alone does not say the car stands: a rear wheel that rode
     up onto the riser's corner stops turning while the car still rocks on it, and the wheels
     can stop just as the rocking car passes level (in the sim on 0.09 m steps: level for an
-    instant, rolled 0.13 and 0.31 rad once at rest).
+    instant, rolled 0.13-0.31 rad at rest).
     """
 
     step = Step.STOP_ON_TOP
