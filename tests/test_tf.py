@@ -109,7 +109,7 @@ class _Probe(Node):
         self.tf: list[TFMessage] = []
         self.tf_static: list[TFMessage] = []
         self.joint_states: list[JointState] = []
-        self.create_subscription(TFMessage, '/tf', self.tf.append, 1000)
+        self.tf_subscription = self.create_subscription(TFMessage, '/tf', self.tf.append, 1000)
         self.create_subscription(TFMessage, '/tf_static', self.tf_static.append, LATCHED)
         self.create_subscription(JointState, 'joint_states', self.joint_states.append, 1000)
 
@@ -134,6 +134,7 @@ def test_link_frames_from_tf_agree_with_pybullet():
     truth: dict[int, dict[str, tuple]] = {}
     try:
         spin_until(executor, lambda: step.service_is_ready() and probe.tf_static
+                   and probe.tf_subscription.get_publisher_count() > 0
                    and frames_node.count_publishers('joint_states') > 0
                    and sim_node.count_subscribers('joint_states') >= 2, TIMEOUT, 'the nodes')
         body, client = sim._body, sim._client
@@ -242,18 +243,33 @@ def test_live_tf_and_a_recorded_bag_place_every_link(ros_domain, tmp_path):
     try:
         spin_until(executor, lambda: step.service_is_ready() and probe.tf_static and all(
             recording(topic) for topic in ('/tf', '/tf_static', '/joint_states'))
-            and probe.count_publishers('/tf') == 2, TIMEOUT,
+            and probe.tf_subscription.get_publisher_count() == 2, TIMEOUT,
             'the nodes, /tf_static and the recorder')
-        # Publishers match a subscription a moment after the graph shows it.
-        time.sleep(1.0)
-        for _ in range(40):
+
+        def step_once() -> int:
             heard = len(probe.joint_states)
             future = step.call_async(StepSimulation.Request(steps=5))
             spin_until(executor, lambda: future.done() and len(probe.joint_states) > heard,
                        TIMEOUT, 'a step')
+            return _ns(probe.joint_states[-1].header.stamp)
+
+        # Stepped until the odometry and robot_description answer (each hears the sim a moment
+        # after the graph shows it); the recorder's subscriptions are as old, give them a
+        # moment more to match.
+        deadline = time.monotonic() + TIMEOUT
+        first = step_once()
+        while not {t.child_frame_id for m in probe.tf for t in m.transforms
+                   if _ns(t.header.stamp) >= first} >= {'base_link', 'front_t'}:
+            assert time.monotonic() < deadline, 'no /tf from the odometry and the links'
+            step_once()
+        time.sleep(1.0)
+        before = len(probe.joint_states)
+        for _ in range(40):
+            step_once()
         last = _ns(probe.joint_states[-1].header.stamp)
-        spin_until(executor, lambda: any(_ns(m.transforms[0].header.stamp) == last
-                                         for m in probe.tf), TIMEOUT, '/tf of the last step')
+        spin_until(executor, lambda: any(
+            (m.transforms[0].child_frame_id, _ns(m.transforms[0].header.stamp))
+            == ('base_link', last) for m in probe.tf), TIMEOUT, 'odom /tf of the last step')
         hashes = {(topic, i.node_name): str(i.topic_type_hash)
                   for topic in ('/tf', '/tf_static')
                   for i in probe.get_publishers_info_by_topic(topic)}
@@ -269,11 +285,12 @@ def test_live_tf_and_a_recorded_bag_place_every_link(ros_domain, tmp_path):
                       ('/tf_static', 'robot_description'): JAZZY_TFMESSAGE_HASH}, hashes
     # Live: odom -> base_link with every state (publish_rate 100 Hz = the sim's 0.01 s period),
     # the moving links at robot_description's 20 Hz of joint_states time, the fixed ones once.
-    stamps = [_ns(s.header.stamp) for s in probe.joint_states]
-    odom = [m for m in probe.tf if m.transforms[0].child_frame_id == 'base_link']
+    stamps = [_ns(s.header.stamp) for s in probe.joint_states[before:]]
+    tf = [m for m in probe.tf if _ns(m.transforms[0].header.stamp) >= stamps[0]]
+    odom = [m for m in tf if m.transforms[0].child_frame_id == 'base_link']
     assert [(t.header.frame_id, _ns(t.header.stamp)) for m in odom for t in m.transforms] \
         == [('odom', stamp) for stamp in stamps]
-    links = [_ns(m.transforms[0].header.stamp) for m in probe.tf if m not in odom]
+    links = [_ns(m.transforms[0].header.stamp) for m in tf if m not in odom]
     assert np.diff(links).tolist() == [50_000_000] * (len(links) - 1)
     assert len(links) >= len(stamps) // 5 - 1
     live = {t.child_frame_id: t.header.frame_id for m in probe.tf_static + probe.tf
@@ -300,9 +317,9 @@ def test_live_tf_and_a_recorded_bag_place_every_link(ros_domain, tmp_path):
     assert example.returncode == 0, example.stderr
     plotted = int(example.stdout.split()[0])
     assert plotted >= len(stamps) and (tmp_path / 'swivel_angle.png').stat().st_size > 0
-    # Every transform heard live is in the bag, with its stamp and values.
+    # Every transform of the 40 steps heard live is in the bag, with its stamp and values.
     assert {_key(t) for m in decoded['messages']['/tf'] for t in m['message']['transforms']} \
-        >= {_key(_as_dict(t)) for m in probe.tf for t in m.transforms}
+        >= {_key(_as_dict(t)) for m in tf for t in m.transforms}
 
 
 def test_mcap_ros2_support_refuses_the_action_feedback_as_the_report_says():
