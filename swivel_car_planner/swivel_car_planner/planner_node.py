@@ -35,13 +35,16 @@ from std_msgs.msg import Header
 from swivel_car_model import dynamics, kinematics
 from swivel_car_model.checks import check_number
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
-from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan, SwivelCommand, SwivelControllerState
+from swivel_car_msgs.msg import (
+    ClimbOutcome, ClimbPlan, DetectedStep, SwivelCommand, SwivelControllerState)
 from swivel_car_msgs.srv import ClimbStep as ClimbStepService
+from swivel_car_perception.core.detector import Detection
 from swivel_car_planner.conversions import (
     controller_state_fields, imu_fields, odom_fields, outcome_to_msg, plan_to_msg, request_from)
 from swivel_car_planner.core import (
     capability, ClimbPlan as Plan, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs,
-    make_plan, PlanError, PlannerConfig, validate_request)
+    make_plan, Phase, PlanError, PlannerConfig, validate_request)
+from swivel_car_planner.core.detected import DetectedSteps
 from swivel_car_planner.core.liveness import ClimbSlot, InputLiveness
 from swivel_car_planner.core.sync import InputSync, Tick
 from swivel_car_ros.lockstep import ChainEntry, Entry
@@ -67,6 +70,7 @@ class _ActiveClimb:
     plan: Plan
     answer: Callable[[_Result], None]  # takes the result once the climb has ended
     goal_handle: ServerGoalHandle | None = None
+    use_detected_step: bool = False  # follows the detector's edge during the approach
     machine: ClimbStateMachine = field(init=False)
     entry: ChainEntry = field(default_factory=ChainEntry)  # its way into the chain
     first_command: Command | None = None  # stands for each tick until the entry engages
@@ -167,6 +171,9 @@ class PlannerNode(Node):
             'ready_timeout', 1.0, 'inputs older than this (in sim and wall time) mean not '
                                   'ready; a climb whose inputs stop for this long aborts [s]')
 
+        self._detected = DetectedSteps(self.description.wheelbase, self._positive_parameter(
+            'detection_max_age', 0.5, 'use_detected_step: the oldest detected_step a climb '
+                                      'takes (the detector publishes one per image) [s]'))
         self._slot: ClimbSlot[_ActiveClimb] = ClimbSlot()
         self._resets = 0  # sim/reset_events heard
         self._plans = _PlanWorker(self)
@@ -180,6 +187,7 @@ class PlannerNode(Node):
         self.create_subscription(SwivelControllerState, _CONTROLLER_STATE,
                                  self._on_controller_state, 10, raw=True)
         self.create_subscription(Header, 'sim/reset_event', self._on_sim_reset, 10)
+        self.create_subscription(DetectedStep, 'detected_step', self._on_detected_step, 10)
         self._command_pub = self.create_publisher(SwivelCommand, 'swivel_command', 10)
         _answer_later(self.create_service(ClimbStepService, 'climb_step', self._on_service))
         self._action = ActionServer(
@@ -255,7 +263,29 @@ class PlannerNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _on_odom(self, data: bytes) -> None:
+        if self._slot.climb is None:  # a climb notes the poses it steers by (_on_tick)
+            fields = read_logged(self.get_logger(), odom_fields, data, inputs.ODOM)
+            if fields is not None:
+                stamp, x, y, orientation, _ = fields
+                if all(math.isfinite(v) for v in (x, y, *orientation)):
+                    self._detected.pose(stamp_to_seconds(stamp), x, y,
+                                        inputs.yaw_of(*orientation))
         self._take(inputs.ODOM, data, odom_fields, inputs.odom_values)
+
+    def _on_detected_step(self, msg: DetectedStep) -> None:
+        s = msg.step
+        values = (s.height, s.distance, s.yaw, s.width, msg.step_offset, s.depth,
+                  msg.height_std, msg.distance_std, msg.yaw_std, msg.width_std)
+        if not all(math.isfinite(v) for v in values):
+            line = self._refusals.line('detected_step', 'a non-finite field',
+                                       time.monotonic())
+            if line is not None:
+                self.get_logger().error(line)
+            return
+        self._detected.heard(stamp_to_seconds(msg.header.stamp), Detection(
+            bool(msg.found), '', s.height, s.distance, s.yaw, s.width, msg.step_offset,
+            s.depth, msg.height_std, msg.distance_std, msg.yaw_std, msg.width_std,
+            bool(msg.left_end_seen), bool(msg.right_end_seen)))
 
     def _on_imu(self, data: bytes) -> None:
         self._take(inputs.IMU, data, imu_fields, inputs.imu_values)
@@ -301,8 +331,22 @@ class PlannerNode(Node):
     # --- the climb ------------------------------------------------------------------------
 
     def _start(self, request: ClimbRequest, answer: Callable[[_Result], None],
-               goal_handle: ServerGoalHandle | None = None) -> None:
-        """Validate, plan and (unless plan_only) climb; ``answer`` takes the result at the end."""
+               goal_handle: ServerGoalHandle | None = None,
+               use_detected_step: bool = False) -> None:
+        """
+        Validate, plan and (unless plan_only) climb; ``answer`` takes the result at the end.
+
+        With ``use_detected_step`` the step is the detector's (its geometry fields ignored).
+        """
+        if use_detected_step:
+            detected, why = self._detected.request(request, self._now())
+            if detected is None:
+                answer(self._failure(ErrorCode.NO_STEP_DETECTED, why))
+                return
+            request = detected
+            self.get_logger().info(
+                f'detected step: {request.step_height:.3f} m high, {request.step_distance:.3f} '
+                f'm ahead, yaw {request.step_yaw:.3f} rad, {request.step_width:.2f} m wide')
         code, message = validate_request(request, self.config)
         if code != ErrorCode.NONE:
             answer(self._failure(code, message))
@@ -319,7 +363,8 @@ class PlannerNode(Node):
         resets = self._resets
 
         def planned(future: Future) -> None:
-            result = self._planned(request, future, resets, answer, goal_handle)
+            result = self._planned(request, future, resets, answer, goal_handle,
+                                   use_detected_step)
             if result is not None:
                 answer(result)
 
@@ -327,8 +372,8 @@ class PlannerNode(Node):
                          ).add_done_callback(planned)
 
     def _planned(self, request: ClimbRequest, planned: Future, resets: int,
-                 answer: Callable[[_Result], None],
-                 goal_handle: ServerGoalHandle | None) -> _Result | None:
+                 answer: Callable[[_Result], None], goal_handle: ServerGoalHandle | None,
+                 use_detected_step: bool = False) -> _Result | None:
         """Return the result of a finished planning; None when the climb has started."""
         if not request.plan_only:
             self._slot.planned(None)
@@ -347,7 +392,7 @@ class PlannerNode(Node):
         climb = _ActiveClimb(
             lambda: ClimbStateMachine(self.robot, self.config, plan, request.step_distance,
                                       request.step_yaw, request.time_allowance),
-            plan, answer, goal_handle)
+            plan, answer, goal_handle, use_detected_step)
         # The climb starts from the moments after its planning (seconds, when a backup is
         # searched): a tick of the inputs collected before would be that old.
         self._sync.clear()
@@ -386,14 +431,54 @@ class PlannerNode(Node):
             self._liveness.engaged(tick.time)
         if climb.goal_handle is not None and climb.goal_handle.is_cancel_requested:
             climb.machine.cancel()
-        command = climb.machine.update(inputs.observation(tick))
+        observation = inputs.observation(tick)
+        command = climb.machine.update(observation)
+        self._follow_detection(climb.machine, observation, tick.time)
         if entry is Entry.FIRST:
             climb.first_command = command
         self._publish_command(command, tick.time)
         if climb.goal_handle is not None:
-            climb.goal_handle.publish_feedback(self._feedback_msg(climb.machine.feedback))
+            feedback = self._feedback_msg(climb.machine.feedback)
+            if climb.use_detected_step:
+                feedback.detected_step = self._detected_step_msg(tick.time)
+            climb.goal_handle.publish_feedback(feedback)
         if climb.machine.outcome is not None:
             self._end(climb, tick.time)
+
+    def _follow_detection(self, machine: ClimbStateMachine, obs, stamp: float) -> None:
+        """
+        Note the pose the climb steers by; in the approach, move its edge to a new detection.
+
+        The climb's heading is the IMU's (odometry's drifts while the swivel turns at a
+        standstill), so the detections are placed with the climb's own poses.
+        """
+        climb = machine.climb
+        if climb is None:
+            return
+        self._detected.pose(stamp, obs.x, obs.y, climb.heading(obs))
+        if machine.phase != Phase.APPROACH or not self._slot.climb.use_detected_step:
+            return
+        edge = self._detected.correction(climb.edge, stamp)
+        if edge is not None:
+            shift = climb.edge.signed_distance(edge.px, edge.py)
+            turn = edge.normal_yaw - climb.edge.normal_yaw
+            climb.edge = edge
+            self.get_logger().info(f'approach: the detected edge is {shift:+.3f} m and '
+                                   f'{turn:+.3f} rad from the planned one: following it')
+
+    def _detected_step_msg(self, stamp: float) -> DetectedStep:
+        """Return the latest fresh detection relative to base_link now (found false: none)."""
+        d, _ = self._detected.fresh(stamp)
+        msg = DetectedStep(found=d is not None)
+        msg.header.stamp = Time(nanoseconds=round(stamp * 1e9)).to_msg()
+        msg.header.frame_id = 'base_link'
+        if d is not None:
+            msg.step.height, msg.step.distance, msg.step.yaw = d.height, d.distance, d.yaw
+            msg.step.width, msg.step.depth, msg.step_offset = d.width, d.depth_seen, d.offset
+            msg.height_std, msg.distance_std = d.height_std, d.distance_std
+            msg.yaw_std, msg.width_std = d.yaw_std, d.width_std
+            msg.left_end_seen, msg.right_end_seen = d.left_end_seen, d.right_end_seen
+        return msg
 
     def _check_alive(self) -> None:
         """End a climb whose inputs stopped (``InputLiveness.check``): the deadman stopped it."""
@@ -471,7 +556,8 @@ class PlannerNode(Node):
     def _on_service(self, request, response) -> Future:
         answered = Future()
         self._start(request_from(request, with_time_allowance=False),
-                    lambda result: answered.set_result(result.fill(response)))
+                    lambda result: answered.set_result(result.fill(response)),
+                    use_detected_step=request.use_detected_step)
         return answered
 
     def _on_goal(self, goal) -> GoalResponse:
@@ -491,7 +577,7 @@ class PlannerNode(Node):
             goal_handle.execute()
 
         self._start(request_from(goal_handle.request, with_time_allowance=True), answer,
-                    goal_handle)
+                    goal_handle, goal_handle.request.use_detected_step)
 
     def _on_execute(self, goal_handle: ServerGoalHandle) -> ClimbStepAction.Result:
         result = self._goal_results.pop(bytes(goal_handle.goal_id.uuid))

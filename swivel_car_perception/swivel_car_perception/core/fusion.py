@@ -188,3 +188,14 @@ def _along(angle: float, x: float, y: float) -> float:
 
 def _wrap(angle: float) -> float:
     return math.atan2(math.sin(angle), math.cos(angle))
+
+
+def moved(detection: Detection, then: Pose2D, now: Pose2D, front_axle: float) -> Detection:
+    """
+    Return ``detection``, seen from base_link at ``then``, relative to base_link at ``now``.
+
+    Both poses are odometry's; the uncertainties are the detection's (no drift added).
+    """
+    tracker = StepTracker(front_axle, drift=0.0)
+    tracker.update(detection, then)
+    return tracker.estimate(now, detection)
