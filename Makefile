@@ -99,6 +99,7 @@ figures: build
 bench: build
 	$(IN_WS) python -m swivel_car_model.benchmark
 	$(IN_WS) python -m swivel_car_sim.benchmark
+	$(IN_WS) python -m swivel_car_perception.benchmark
 	$(IN_WS) python scripts/chain_benchmark.py
 	$(IN_WS) python -m swivel_car_control.benchmark
 	$(IN_WS) python -m swivel_car_bringup.benchmark
