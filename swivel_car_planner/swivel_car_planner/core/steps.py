@@ -322,7 +322,7 @@ class Approach(StepBehaviour):
     Semi-active: it turns onto the line through the crossing no sooner than the arc of
     ``plan.semi_active_turn`` meets it tangentially (``_turn_in``), and the lift point accepts
     a heading up to twice ``align_tolerance`` more oblique than planned (the steering wheel only
-    gets further off the riser), not less.
+    gets further off the riser: the minimum approach angle is a lower bound), not less.
     """
 
     step = Step.APPROACH
@@ -345,8 +345,6 @@ class Approach(StepBehaviour):
         config, plan = climb.config, climb.plan
         if climb.lifted_wheel_distance(obs) >= self.goal():
             error = plan.approach_heading - climb.edge.relative_heading(climb.heading(obs))
-            # Semi-active: more oblique only moves the steering wheel further off the riser
-            # (the minimum approach angle is a lower bound): twice the tolerance.
             oblique = (climb.semi_active
                        and 0.0 <= plan.lifted_side * error <= 2.0 * config.align_tolerance)
             if abs(error) > config.align_tolerance and not oblique:
