@@ -1,14 +1,14 @@
 """
-The step detector's accuracy and cost on the sim's depth camera: ``python -m
-swivel_car_perception.benchmark [--steps 120] [--seed 35]``.
+The step detector's accuracy and cost on the sim's depth camera.
 
-Randomised box steps (heights 3-20 cm, edges 0.4-1.5 m ahead of the front axle, yaw +-0.3 rad,
-faces 0.5-3 m wide, centred on the car's axis) are spawned one at a time in front of the car
-in the sim; the camera (D435 noise, dropouts) takes a frame of each, and the detector measures
-it. Errors against the spawned truth: the 95th percentile of height, distance, yaw and (with
-both ends seen) width, for one frame and for five frames fused (the car standing, fresh noise
-in each). Flat ground with fresh noise gives the false positives. Costs: the sim's own physics
-per sim second, the camera's rendering per sim second at 10 Hz, the detector per frame.
+``python -m swivel_car_perception.benchmark [--steps 120] [--seed 35]``. Randomised box steps
+(heights 3-20 cm, edges 0.4-1.5 m ahead of the front axle, yaw +-0.3 rad, faces 0.5-3 m wide,
+centred on the car's axis) are spawned one at a time in front of the car in the sim; the
+camera (D435 noise, dropouts) takes a frame of each, and the detector measures it. Errors
+against the spawned truth: the 95th percentile of height, distance, yaw and (with both ends
+seen) width, for one frame and for five frames fused (the car standing, fresh noise in each).
+Flat ground with fresh noise gives the false positives. Costs: the sim's own physics per sim
+second, the camera's rendering per sim second at 10 Hz, the detector per frame.
 """
 
 from __future__ import annotations

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 import sys
+import time
 
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
@@ -27,6 +28,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 IMAGE_TOPIC = 'camera/depth/image_rect_raw'
 INFO_TOPIC = 'camera/depth/camera_info'
+REFUSAL_INTERVAL = 5.0  # [s] wall time between two lines about one kind of refusal
 
 
 @dataclass(frozen=True)
@@ -83,6 +85,7 @@ class StepDetectorNode(Node):
         self._tracker = StepTracker(robot.wheelbase, config.odom_drift, config.gate,
                                     int(config.max_misses))
         self._poses = PoseHistory()
+        self._next_refusal: dict[str, float] = {}  # kind -> wall time [s] its next line is due
         self._step_pub = self.create_publisher(DetectedStep, 'detected_step', 10)
         self._marker_pub = self.create_publisher(MarkerArray, '~/markers', 10)
         self.create_subscription(CameraInfo, INFO_TOPIC, self._on_camera_info,
@@ -99,7 +102,7 @@ class StepDetectorNode(Node):
         try:
             intrinsics = intrinsics_from_camera_info(info.width, info.height, info.k)
         except ValueError as error:
-            self.get_logger().warn(f'refusing camera_info: {error}', throttle_duration_sec=5.0)
+            self._refuse(f'refusing camera_info: {error}')
             return
         if self._detector is None or self._detector.intrinsics != intrinsics:
             self._detector = StepDetector(intrinsics, self._mount, self._detector_config)
@@ -116,15 +119,14 @@ class StepDetectorNode(Node):
 
     def _on_image(self, image: Image) -> None:
         if self._detector is None:
-            self.get_logger().warn(f'refusing depth images: no camera_info yet on {INFO_TOPIC}',
-                                   throttle_duration_sec=5.0)
+            self._refuse(f'refusing depth images: no camera_info yet on {INFO_TOPIC}')
             return
         try:
             depth = depth_from_fields(image.encoding, image.width, image.height, image.step,
                                       image.is_bigendian, bytes(image.data),
                                       self._detector.intrinsics)
         except ValueError as error:
-            self.get_logger().warn(f'refusing depth image: {error}', throttle_duration_sec=5.0)
+            self._refuse(f'refusing depth image: {error}')
             return
         detection = self._detector.detect(depth)
         stamp = image.header.stamp.sec * 1_000_000_000 + image.header.stamp.nanosec
@@ -137,6 +139,13 @@ class StepDetectorNode(Node):
         if not detection.found:
             self.get_logger().debug(f'no step: {detection.reason}')
         self._publish(image, detection)
+
+    def _refuse(self, line: str) -> None:
+        """Log ``line``, at most once per REFUSAL_INTERVAL for its kind (its first words)."""
+        kind, now = ' '.join(line.split()[:6]), time.monotonic()
+        if now >= self._next_refusal.get(kind, -math.inf):
+            self._next_refusal[kind] = now + REFUSAL_INTERVAL
+            self.get_logger().warn(line)
 
     # --- outputs ---------------------------------------------------------------------------
 

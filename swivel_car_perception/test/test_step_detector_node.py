@@ -5,6 +5,7 @@ import os
 
 import numpy as np
 import pytest
+from rcl_interfaces.msg import Log
 import rclpy
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
@@ -34,7 +35,9 @@ class Rig:
         self.executor = EventsExecutor(context=self.context)
         self.executor.add_node(self.detector)
         self.executor.add_node(self.client)
-        self.steps, self.markers = [], []
+        self.steps, self.markers, self.logs = [], [], []
+        self.client.create_subscription(Log, '/rosout', lambda log: self.logs.append(log.msg),
+                                        100)
         self.client.create_subscription(DetectedStep, 'detected_step', self.steps.append, 10)
         self.client.create_subscription(MarkerArray, 'step_detector/markers',
                                         self.markers.append, 10)
@@ -58,6 +61,10 @@ class Rig:
         message.data = array.array('B', depth.astype('<f4').tobytes())
         self.images.publish(message)
 
+    def logged(self, words: str) -> None:
+        spin_until(self.executor, lambda: any(words in line for line in self.logs), TIMEOUT,
+                   f'the log line {words!r}')
+
     def next_step(self, count: int) -> DetectedStep:
         spin_until(self.executor, lambda: len(self.steps) >= count, TIMEOUT, 'detected_step')
         return self.steps[count - 1]
@@ -78,11 +85,14 @@ def rig():
 
 def test_refusals_then_a_step_and_its_marker(rig):
     scene = depth_image(STEP, noise_seed=4)
-    rig.image(1, scene)  # before any camera_info: refused
+    rig.image(1, scene)
+    rig.logged('refusing depth images: no camera_info yet')
     rig.info()
     spin_until(rig.executor, lambda: rig.detector._detector is not None, TIMEOUT, 'info')
-    rig.image(2, scene, encoding='rgb8')  # not a depth encoding: refused
-    rig.image(3, scene[:60, :106])  # not camera_info's size: refused
+    rig.image(2, scene, encoding='rgb8')
+    rig.logged("refusing depth image: depth image encoding 'rgb8' is not a depth encoding")
+    rig.image(3, scene[:60, :106])
+    rig.logged('refusing depth image: depth image is 106x60 but its camera_info says 212x120')
     rig.image(4, scene)
     step = rig.next_step(1)
     # Only the fourth image was taken: the refused ones published nothing.
@@ -100,7 +110,8 @@ def test_refusals_then_a_step_and_its_marker(rig):
 def test_no_return_and_flat_ground_are_found_false(rig):
     before = len(rig.steps)
     rig.image(5, np.full((INTRINSICS.height, INTRINSICS.width), np.nan))
+    blank = rig.next_step(before + 1)
     rig.image(6, depth_image(noise_seed=5))
-    blank, flat = rig.next_step(before + 1), rig.next_step(before + 2)
+    flat = rig.next_step(before + 2)
     assert (blank.header.stamp.sec, flat.header.stamp.sec) == (5, 6)
     assert not blank.found and not flat.found and flat.step.height == 0.0
