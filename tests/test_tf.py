@@ -243,7 +243,7 @@ def test_live_tf_and_a_recorded_bag_place_every_link(ros_domain, tmp_path):
     try:
         spin_until(executor, lambda: step.service_is_ready() and probe.tf_static and all(
             recording(topic) for topic in ('/tf', '/tf_static', '/joint_states'))
-            and probe.tf_subscription.get_publisher_count() == 2, TIMEOUT,
+            and probe.tf_subscription.get_publisher_count() >= 2, TIMEOUT,
             'the nodes, /tf_static and the recorder')
 
         def step_once() -> int:
@@ -280,9 +280,9 @@ def test_live_tf_and_a_recorded_bag_place_every_link(ros_domain, tmp_path):
         codes = {p.name: p.stop() for p in stack}
     assert set(codes.values()) == {0}, codes
     # On the wire: Jazzy's type, by its hash, from the odometry and the robot description.
-    assert hashes == {('/tf', 'odometry'): JAZZY_TFMESSAGE_HASH,
-                      ('/tf', 'robot_description'): JAZZY_TFMESSAGE_HASH,
-                      ('/tf_static', 'robot_description'): JAZZY_TFMESSAGE_HASH}, hashes
+    assert set(hashes) >= {('/tf', 'odometry'), ('/tf', 'robot_description'),
+                           ('/tf_static', 'robot_description')}, hashes
+    assert set(hashes.values()) == {JAZZY_TFMESSAGE_HASH}, hashes
     # Live: odom -> base_link with every state (publish_rate 100 Hz = the sim's 0.01 s period),
     # the moving links at robot_description's 20 Hz of joint_states time, the fixed ones once.
     stamps = [_ns(s.header.stamp) for s in probe.joint_states[before:]]
