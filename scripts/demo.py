@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 """
-The main job: the simulated swivel car drives to a step and climbs it.
+The main job: the simulated swivel car drives to a step, finds it and climbs it.
 
 Starts the stack the way a user would with `ros2 run`: the installed `sim_node`,
-`controller_node`, `odometry_node` and `planner_node`, each in its own process, headless, on
-sim time, in lockstep. Then, like a user: spawns a step in front of the car, drives towards it
-with velocity commands on `cmd_vel`, and asks the planner to climb it through the `climb_step`
-action. Prints a progress line while it runs and a summary at the end, and writes a report
-(plots, rendered frames, index.md) to the report folder. Exit code 0 only if the climb
+`controller_node`, `odometry_node`, `planner_node` and `step_detector_node`, each in its
+own process, headless, on sim time, in lockstep. Then, like a user: spawns a step in front
+of the car, drives towards it with velocity commands on `cmd_vel`, and asks the planner to
+climb the step the car detected through the `climb_step` action (`use_detected_step`):
+nobody tells the planner where the step is. Prints a progress line while it runs and a
+summary at the end, and writes a report (plots, rendered frames, the depth image and the
+detection beside the truth, index.md) to the report folder. Exit code 0 only if the climb
 succeeded.
 """
 
@@ -29,8 +31,10 @@ from rclpy.action import ActionClient
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.qos import qos_profile_sensor_data
+from sensor_msgs.msg import Image
 from swivel_car_msgs.action import ClimbStep
-from swivel_car_msgs.msg import StepObstacle
+from swivel_car_msgs.msg import DetectedStep, StepObstacle
 from swivel_car_msgs.srv import SpawnObstacle
 from swivel_car_planner.core import capability
 from swivel_car_ros.ros_params import stamp_to_seconds
@@ -39,7 +43,8 @@ from swivel_car_stack import (
     lockstep_parameters, NodeProcess, REPO_ROOT, spin_until, start_node)
 
 NODES = (('swivel_car_sim', 'sim_node'), ('swivel_car_control', 'controller_node'),
-         ('swivel_car_control', 'odometry_node'), ('swivel_car_planner', 'planner_node'))
+         ('swivel_car_control', 'odometry_node'), ('swivel_car_planner', 'planner_node'),
+         ('swivel_car_perception', 'step_detector_node'))
 # What the recorder must have subscribed to before the demo moves (it records every topic;
 # the report is drawn from the bag).
 RECORDED = ('/clock', '/joint_states', '/ground_truth/odom', '/odom',
@@ -69,6 +74,14 @@ class DemoNode(Node):
         self.cmd_vel = self.create_publisher(TwistStamped, 'cmd_vel', 10)
         self.spawn = self.create_client(SpawnObstacle, 'sim/spawn_obstacle')
         self.climb = ActionClient(self, ClimbStep, 'climb_step')
+        self.detections: list[DetectedStep] = []
+        self.depth: Image | None = None  # the camera's last frame
+        self.create_subscription(DetectedStep, 'detected_step', self.detections.append, 10)
+        self.create_subscription(Image, 'camera/depth/image_rect_raw', self._on_depth,
+                                 qos_profile_sensor_data)
+
+    def _on_depth(self, msg: Image) -> None:
+        self.depth = msg
 
     def recorded(self, topics) -> bool:
         """Whether the recorder subscribes to every one of ``topics``."""
@@ -200,9 +213,16 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
             if len(node.recording.truth) - stopped_at > 50 and max(xs) - min(xs) < 1e-3:
                 break
 
-        goal = ClimbStep.Goal(step_height=args.step_height,
-                              step_distance=args.step_distance - travelled(), step_yaw=0.0,
-                              step_width=step.width, plan_only=False,
+        # The planner climbs what the detector saw since the car stopped.
+        stopped = node.recording.truth[-1][0]
+        progress.show('detect', 'waiting for the step detector to see the step')
+        spin_until(executor, lambda: check_alive() or (
+            node.detections and node.detections[-1].found
+            and stamp_to_seconds(node.detections[-1].header.stamp) >= stopped), 30.0,
+            'a detection of the step after stopping')
+        seen, frame = node.detections[-1], node.depth
+        seen_truth_x = node.recording.truth[-1][1]  # [m] base_link's x in the world then
+        goal = ClimbStep.Goal(use_detected_step=True, plan_only=False,
                               time_allowance=args.time_allowance)
         climb_start = node.recording.truth[-1][0]
         sent = node.climb.send_goal_async(goal, feedback_callback=lambda f: progress.show(
@@ -227,8 +247,19 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
         if failed:
             print(f'warning: nodes exited with {failed}', file=sys.stderr)
     recording = read_bag(args.report / 'bag')
-    return summarise(args, recording, result, climb_start, climb_end,
-                     time.monotonic() - wall_start), recording
+    summary = summarise(args, recording, result, climb_start, climb_end,
+                        time.monotonic() - wall_start)
+    s = seen.step
+    summary['detected'] = {'height': s.height, 'distance': s.distance, 'yaw': s.yaw,
+                           'width': s.width, 'ends': (seen.left_end_seen, seen.right_end_seen),
+                           'height_std': seen.height_std, 'distance_std': seen.distance_std,
+                           'yaw_std': seen.yaw_std}
+    # The car stands square to the step at the world's y = 0 (its heading drifts by less
+    # than a milliradian while it drives straight).
+    summary['truth_step'] = {'height': step.height, 'distance': step.distance - seen_truth_x,
+                             'yaw': step.yaw, 'width': step.width}
+    summary['depth_frame'] = frame
+    return summary, recording
 
 
 def summarise(args, recording: Recording, result, climb_start: float, climb_end: float,
@@ -291,6 +322,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     print_summary(summary)
     page = write_report(summary, recording, demo_step(args), args.report)
+    append_detection(page, summary)
     print(f'  report               {page}')
     return 0 if summary['success'] else 1
 
@@ -306,6 +338,50 @@ def print_summary(summary: dict) -> None:
           f"(planned {summary['planned_energy']:.2f})")
     print(f"  odometry error       {summary['odometry_error']:.3f} m over "
           f"{summary['path_length']:.2f} m ({summary['odometry_error_percent']:.1f} %)")
+    for name, scale, unit in DETECTION_ROWS:
+        seen, truth = summary['detected'][name], summary['truth_step'][name]
+        print(f'  detected {name:<12}{seen * scale:7.1f} {unit} (truth {truth * scale:.1f} '
+              f'{unit})')
+
+
+DETECTION_ROWS = (('height', 100.0, 'cm'), ('distance', 100.0, 'cm'), ('yaw', 1.0, 'rad'),
+                  ('width', 100.0, 'cm'))
+
+
+def append_detection(page: Path, summary: dict) -> None:
+    """Add what the car saw to the report: its depth image, the detection beside the truth."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    lines = ['', '## What the car saw', '',
+             'The climb was `climb_step {use_detected_step: true}`: the planner was not told '
+             "where the step is. The step detector measured it in the depth camera's images "
+             '(a RealSense D435-class camera on the body, rendered by the sim with its noise); '
+             'the planner took its latest detection after the car stopped.', '']
+    frame = summary['depth_frame']
+    if frame is not None:
+        depth = np.frombuffer(bytes(frame.data), dtype='<f4').reshape(frame.height, frame.width)
+        figure, axes = plt.subplots(figsize=(6.4, 3.8))
+        shown = axes.imshow(depth, cmap='viridis', vmin=0.0, vmax=3.0)
+        figure.colorbar(shown, ax=axes, label='depth [m] (white: no return)')
+        axes.set_title('depth image (32FC1) when the climb was asked')
+        axes.set_axis_off()
+        figure.savefig(page.parent / 'depth.png', dpi=100, bbox_inches='tight')
+        plt.close(figure)
+        lines += ['![the depth image the detector saw](depth.png)', '']
+    detected, truth = summary['detected'], summary['truth_step']
+    lines += ['| | detected (one sigma) | truth |', '|---|---|---|']
+    sigmas = {'height': detected['height_std'], 'distance': detected['distance_std'],
+              'yaw': detected['yaw_std']}
+    for name, scale, unit in DETECTION_ROWS:
+        sigma = f' (+-{sigmas[name] * scale:.2g})' if name in sigmas else ''
+        lines.append(f'| {name} | {detected[name] * scale:.2f}{sigma} {unit} | '
+                     f'{truth[name] * scale:.2f} {unit} |')
+    left, right = detected['ends']
+    lines += ['', f'Ends of the edge seen: left {left}, right {right} (the width is measured '
+                  'only between seen ends; otherwise it is what was in view).', '']
+    with page.open('a') as out:
+        out.write('\n'.join(lines))
 
 
 if __name__ == '__main__':
