@@ -1,3 +1,5 @@
+import dataclasses
+
 import pytest
 
 from swivel_car_model.description import CarDescription
@@ -17,11 +19,31 @@ def test_limit_is_the_top_of_the_unbroken_reliable_run():
     assert table([5, 8]).limit == 0.0
 
 
+def test_with_a_confidence_the_limit_is_where_the_lower_bound_stays_reliable():
+    heights = (0.02, 0.03, 0.04, 0.05)
+    bounded = CapabilityTable(heights, (40, 40, 40, 40), (40, 38, 37, 40),
+                              description_values(CarDescription()), reliable=0.85,
+                              confidence=0.9)
+    # Clopper-Pearson, one-sided 90 %: 40/40 -> 0.1 ** (1 / 40) = 0.944; 37/40 -> 0.83.
+    assert bounded.lower_bounds[0.02] == pytest.approx(0.1 ** (1.0 / 40.0))
+    assert 0.85 < bounded.lower_bounds[0.03] < 38 / 40
+    assert bounded.lower_bounds[0.04] < 0.85 < 37 / 40
+    assert bounded.limit == pytest.approx(0.03)
+    # 8 of 8 bound the rate only at 0.75: no statement of 85 % from so few trials.
+    assert table([8, 8], description=None).limit == pytest.approx(0.03)
+    few = CapabilityTable((0.02,), (8,), (8,), description_values(CarDescription()),
+                          reliable=0.85, confidence=0.9)
+    assert few.limit == 0.0
+
+
 def test_the_table_round_trips_through_its_file(tmp_path):
     original = table([8, 8, 4])
     original.save(tmp_path / 'capability.yaml', header='made by a test')
     loaded = CapabilityTable.load(tmp_path / 'capability.yaml')
     assert loaded == original
+    bounded = dataclasses.replace(original, reliable=0.85, confidence=0.9)
+    bounded.save(tmp_path / 'bounded.yaml')
+    assert CapabilityTable.load(tmp_path / 'bounded.yaml') == bounded
     assert (tmp_path / 'capability.yaml').read_text().startswith('# made by a test')
 
 
