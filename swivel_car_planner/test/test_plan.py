@@ -21,6 +21,8 @@ FRONT = CONFIG
 # The standard lift wherever it can plan (the push-lift takes over from 24 cm by default).
 STANDARD = dataclasses.replace(CONFIG, push_lift_height=0.3)
 WHOLE_CAR_LIMIT = 0.08  # [m]
+# Backing up straight only: the refusals the repositioning (test_reposition.py) overcomes.
+STRAIGHT = dataclasses.replace(CONFIG, max_reposition=0.0)
 
 
 def request(height=0.05, distance=1.2, yaw=0.0, plan_only=False, width=0.0, offset=0.0):
@@ -91,7 +93,7 @@ def test_step_above_the_measured_whole_car_limit_is_refused_with_the_limit():
 
 
 def test_plan_only_makes_exactly_the_checks_of_a_real_call():
-    no_backup = dataclasses.replace(CONFIG, max_backup=0.0)
+    no_backup = dataclasses.replace(STRAIGHT, max_backup=0.0)
     for kwargs in ({'height': WHOLE_CAR_LIMIT + 0.01}, {'distance': 0.1, 'config': no_backup},
                    {'width': 0.3}):
         real = refusal(whole_car_limit=WHOLE_CAR_LIMIT, **kwargs)
@@ -280,11 +282,11 @@ def test_wheel_interference_refuses_a_long_shaft_on_a_short_body():
 
 
 def test_step_too_close_to_align_is_invalid_without_room_to_back_up():
-    error = refusal(config=dataclasses.replace(FRONT, max_backup=0.0), height=0.05,
+    error = refusal(config=dataclasses.replace(STRAIGHT, max_backup=0.0), height=0.05,
                     distance=0.1)
     assert error.code == ErrorCode.INVALID_REQUEST
     assert 'too close' in error.message
-    error = refusal(config=dataclasses.replace(FRONT, max_backup=0.2), height=0.05,
+    error = refusal(config=dataclasses.replace(STRAIGHT, max_backup=0.2), height=0.05,
                     distance=0.1, yaw=0.5)
     assert 'too close' in error.message and 'max_backup' in error.message
 
@@ -292,7 +294,7 @@ def test_step_too_close_to_align_is_invalid_without_room_to_back_up():
 def test_a_refusal_after_backing_up_says_what_still_stands_in_the_way():
     # Straight at a face centred on the car: backing up makes room to turn, but the single
     # turn onto the lead angle then crosses the edge beside the face.
-    error = refusal(height=0.05, distance=0.6, width=1.6)
+    error = refusal(config=STRAIGHT, height=0.05, distance=0.6, width=1.6)
     assert error.code == ErrorCode.INVALID_REQUEST
     first, _, then = error.message.partition('max_backup')
     assert 'aligning to' in first and 'beside the top face' in then
@@ -310,7 +312,7 @@ def test_a_close_step_is_planned_from_the_least_backup_that_makes_room(yaw, widt
     # ...and one increment less would not do.
     shorter = near.backup_distance - 0.05
     with pytest.raises(PlanError, match='too close'):
-        make_plan(P, dataclasses.replace(CONFIG, max_backup=0.0),
+        make_plan(P, dataclasses.replace(STRAIGHT, max_backup=0.0),
                   request(0.05, distance=0.2 + shorter, yaw=yaw, width=width))
 
 
@@ -336,7 +338,7 @@ def test_the_crossing_keeps_every_wheel_on_the_top_face(yaw, offset):
 
 
 def test_a_face_the_approach_cannot_reach_is_refused_as_too_close():
-    error = refusal(height=0.05, distance=1.0, width=1.5, offset=2.5)
+    error = refusal(config=STRAIGHT, height=0.05, distance=1.0, width=1.5, offset=2.5)
     assert error.code == ErrorCode.INVALID_REQUEST
     assert 'beside the top face' in error.message
 

@@ -32,6 +32,14 @@ class PlannerConfig:
     max_backup: float = described(
         1.0, 'a step too close to turn onto the approach: the car first backs up straight, '
         'at most this far (what is behind it is not checked); 0: refuse instead [m]')
+    max_reposition: float = described(
+        4.0, 'where backing up does not make room for the approach either, the car first '
+        'drives to a pose it can start from (turning with the swivel at swivel_limit, '
+        'straight, forwards or backwards, clear of the step): on a path at most this long; '
+        '0: refuse instead [m]')
+    reposition_clearance: float = described(
+        0.1, "repositioning keeps the car's footprint this far from the step's box (the "
+        "swivel's moves at a standstill and odometry drift move it off the planned path) [m]")
     lead_margin: float = described(
         0.03, 'lifted wheel past the edge while the other front wheel is still clear [m]')
     lift_gap: float = described(0.03, 'lifted wheel front to the riser when the lift starts [m]')

@@ -92,6 +92,8 @@ from swivel_car_model.params import SwivelCarParams
 
 from swivel_car_planner.core.codes import ErrorCode
 from swivel_car_planner.core.config import PlannerConfig
+from swivel_car_planner.core.reposition import (
+    collides, plan_path, Pose, reposition_length, Segment, StepBox)
 from swivel_car_planner.core.request import ClimbRequest
 
 PROCEDURE_ACTIVE_LIFT = 0  # ClimbPlan.PROCEDURE_ACTIVE_LIFT
@@ -138,6 +140,9 @@ class ClimbPlan:
     crossing: float | None = None
     # [m] the car first backs up this far, straight, to make room for the approach
     backup_distance: float = 0.0
+    # Or, where that does not make room, it first drives this path (``reposition`` module)
+    # to a staging pose the approach starts from
+    reposition: tuple[Segment, ...] = ()
     # [rad] heading change while the lifted wheel advances over the edge (the arc; module
     # docstring); ``lead_angle - advance_turn`` is the heading once the wheel is up
     advance_turn: float = 0.0
@@ -553,6 +558,8 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
     # against the riser.
     semi_active = p.phi < 0.0
     push = not semi_active and height >= config.push_lift_height
+    reposition: tuple[Segment, ...] = ()
+    staging = requested  # the request as seen from where the approach starts
     for backup in _backups(config.max_backup):
         request = dataclasses.replace(requested, step_distance=requested.step_distance + backup)
         try:
@@ -571,13 +578,20 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
         if backup == 0.0:
             first_error = approach.error
     else:
-        raise PlanError(ErrorCode.INVALID_REQUEST,
-                        first_error if config.max_backup == 0.0 else
-                        f'{first_error}; backing up {config.max_backup:.2f} m (max_backup) '
-                        f'does not make room either: then {approach.error}')
+        if config.max_reposition == 0.0:
+            raise PlanError(ErrorCode.INVALID_REQUEST,
+                            first_error if config.max_backup == 0.0 else
+                            f'{first_error}; backing up {config.max_backup:.2f} m (max_backup) '
+                            f'does not make room either: then {approach.error}')
+        # No room from here, straight back either: drive to where there is.
+        request, backup = requested, 0.0
+        approach, reposition, staging = _staged(p, config, request, theta2, leading, push,
+                                                first_error)
     if push:  # it lifts the wheel as high as the swivel goes (module docstring)
         theta2 = p.swivel_limit
         theta1, tip_margin, interference = _lift_rules(p, config, height, theta2)
+    if reposition:
+        request = staging
     available = request.step_distance * math.cos(request.step_yaw)
     side, psi_lead, approach_heading = approach.side, approach.lead, approach.heading
     lead_distance, axle_normal = approach.lead_distance, approach.axle_normal
@@ -587,7 +601,9 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
     v_approach = config.approach_speed * p.r  # [m/s]
     v_climb = config.climb_speed * p.r  # [m/s]
     cos_lead = math.cos(psi_lead)
-    duration = ((backup + max(0.0, available - axle_normal) / max(0.5, cos_lead)) / v_approach
+    travelled = backup + reposition_length(reposition)  # [m] before the approach
+    duration = ((travelled + max(0.0, available - axle_normal) / max(0.5, cos_lead)) / v_approach
+                + 2.0 * len(reposition) * p.swivel_limit / config.swivel_rate
                 + 2.0 * abs(theta2) / config.swivel_rate + config.settle_time
                 + approach.arc.length / v_climb
                 + (p.wheelbase + 2.0 * p.h * abs(math.sin(psi_lead)) + config.rest_margin)
@@ -602,9 +618,88 @@ def make_plan(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest,
         lifted_side=side, lead_angle=psi_lead, lead_distance=lead_distance,
         second_swivel_angle=-side * float(kinematics.swivel_for_step(
             p, config.clearance_margin, respect_tip_over=False)),
-        step_height=height, crossing=approach.crossing, backup_distance=backup,
+        step_height=height, crossing=(None if approach.crossing is None else approach.crossing
+                  + requested.step_offset - staging.step_offset),
+        backup_distance=backup, reposition=reposition,
         advance_turn=approach.arc.turn, advance_length=approach.arc.length, push_lift=push,
         lifted_point=landing_point(p, height, side) if push else (0.0, 0.0))
+
+
+# [m] front axle to the edge (along base_link x) at the staging poses tried
+_STAGING_DISTANCES = (0.3, 0.5, 0.8, 1.2)
+
+
+def _staged(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest, theta2: float,
+            leading: int, push: bool, first_error: str
+            ) -> tuple[_Approach, tuple[Segment, ...], ClimbRequest]:
+    """
+    Plan the approach from a staging pose, and the path there (``reposition`` module).
+
+    The staging poses tried stand ``_STAGING_DISTANCES`` before the edge, at an approach's
+    heading or square to the edge, placed so that the approach crosses the edge in the middle
+    of the crossings its wheels stay on the top face from. The shortest clear path to one the
+    approach can start from wins.
+
+    Returns
+    -------
+    (approach, path, staging)
+        The approach as planned from the staging pose, the path there, and the request as
+        seen from the staging pose.
+
+    Raises
+    ------
+    PlanError
+        ``INVALID_REQUEST``: the top face is too narrow for the track at the lead angle (no
+        staging pose helps), or no clear path up to ``max_reposition`` reaches one.
+
+    """
+    approaches = _approaches(p, config, request, theta2, leading, push)
+    if all(a.shift == math.inf for a in approaches):
+        raise PlanError(ErrorCode.INVALID_REQUEST, approaches[0].error)
+    normal = request.step_yaw  # [rad] the edge's normal in the request's frame
+    edge_x = p.wheelbase + request.step_distance  # [m]
+    stagings, goals = [], []
+    for approach in approaches:
+        # Aim at the middle of the crossings that keep the wheels on the top face.
+        middle = (sum(crossing_range(p, config, request, approach.lead)) / 2.0
+                  if request.step_width > 0.0 else 0.0)  # [m]
+        for distance in _STAGING_DISTANCES:
+            reach = p.wheelbase + distance  # [m] base_link to the edge along its x
+            # At the approach heading the car's x axis meets the edge at the crossing;
+            # square to the edge, turning onto the heading at once takes it there.
+            for heading, along in ((approach.heading, middle),
+                                   (0.0, middle - reach * math.tan(approach.heading))):
+                stagings.append(dataclasses.replace(
+                    request, step_distance=distance, step_yaw=-heading,
+                    step_offset=request.step_offset - along))
+                goals.append(Pose(edge_x - along * math.sin(normal)
+                                  - reach * math.cos(normal + heading),
+                                  along * math.cos(normal) - reach * math.sin(normal + heading),
+                                  normal + heading))
+    chosen: dict[int, _Approach | None] = {}
+
+    def approachable(index: int) -> bool:
+        if index not in chosen:
+            options = _approaches(p, config, stagings[index], theta2, leading, push)
+            usable = [a for a in options if a.error is None]
+            chosen[index] = usable[0] if usable else None
+        return chosen[index] is not None
+
+    box = StepBox(edge_x, normal, request.step_width, request.step_offset)
+    if collides(p, [Pose(0.0, 0.0, 0.0)], box, 0.0, swept=False):
+        raise PlanError(ErrorCode.INVALID_REQUEST,
+                        f'{first_error}; and the car stands against the step (a wheel over '
+                        f"the edge's line within the top face): it cannot move from there")
+    found = plan_path(p, goals, approachable, box, config.reposition_clearance,
+                      config.max_reposition)
+    if found is None:
+        raise PlanError(ErrorCode.INVALID_REQUEST,
+                        f'{first_error}; and no path of at most {config.max_reposition:.2f} m '
+                        f'(max_reposition) on the free floor, '
+                        f'{config.reposition_clearance:.2f} m clear of the step, reaches a '
+                        f'pose the approach can start from')
+    path, index = found
+    return chosen[index], path, stagings[index]
 
 
 def _lift_rules(p: SwivelCarParams, config: PlannerConfig, height: float,
