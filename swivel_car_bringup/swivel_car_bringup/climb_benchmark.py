@@ -476,7 +476,7 @@ def main(argv: list[str] | None = None) -> None:
             'Whole-car climbing capability of the robot description below, measured in physics\n'
             f'through the in-process stack by the command below (seed {seed}):\n'
             f'  {command}\n'
-            'Success: all four wheels on top, level, at rest (the sim\'s ground truth). The\n'
+            "Success: all four wheels on top, level, at rest (the sim's ground truth). The\n"
             f'planner refuses steps above its limit, {STATISTIC}:\n'
             f'{table.limit:.3f} m.'))
         print(f'wrote {args.write_capability}: whole-car limit {table.limit:.3f} m')

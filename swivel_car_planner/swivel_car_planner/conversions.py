@@ -24,9 +24,11 @@ def plan_to_msg(plan: ClimbPlan) -> ClimbPlanMsg:
     msg = ClimbPlanMsg()
     for name in ('swivel_angle', 'lift_angle', 'wheel_clearance', 'approach_distance',
                  'approach_heading', 'peak_torque', 'energy', 'max_scalable_step',
-                 'tip_over_margin', 'interference_margin', 'duration'):
+                 'tip_over_margin', 'interference_margin', 'duration', 'backup_distance'):
         setattr(msg, name, float(getattr(plan, name)))
     msg.procedure = int(plan.procedure)
+    msg.reposition_swivel = [float(s.swivel) for s in plan.reposition]
+    msg.reposition_length = [float(s.length) for s in plan.reposition]
     return msg
 
 

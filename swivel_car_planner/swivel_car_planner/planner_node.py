@@ -250,7 +250,9 @@ class PlannerNode(Node):
                 f'the capability table {path} was measured on another robot description; '
                 'its limit may not hold for this one (regenerate it: python -m '
                 'swivel_car_bringup.climb_benchmark --write-capability)')
-        self.get_logger().info(f'whole-car limit {table.limit:.3f} m (success >= '
+        bound = ('' if table.confidence is None
+                 else f'lower {table.confidence:.0%} confidence bound on ')
+        self.get_logger().info(f'whole-car limit {table.limit:.3f} m ({bound}success >= '
                                f'{table.reliable:.0%} in {path})')
         return table.limit
 

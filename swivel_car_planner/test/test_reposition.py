@@ -4,13 +4,16 @@ import dataclasses
 import math
 
 from hypothesis import given, settings, strategies as st
+from kinematic_car import KinematicCar
 import numpy as np
 import pytest
 from swivel_car_model import dynamics, planar
 from swivel_car_model.params import SwivelCarParams
 
-from swivel_car_planner.core import ClimbRequest, ErrorCode, make_plan, PlanError, PlannerConfig
+from swivel_car_planner.core import (
+    ClimbRequest, ClimbStateMachine, ErrorCode, make_plan, PlanError, PlannerConfig)
 from swivel_car_planner.core.reposition import footprint, Pose, propagate, reposition_length
+from swivel_car_planner.core.state_machine import Step
 
 P = SwivelCarParams()
 CONFIG = PlannerConfig()
@@ -34,8 +37,8 @@ def dense_path(p, plan):
     """
     x = y = yaw = swivel = 0.0
     rows = [(x, y, yaw, False)]
-    for segment in (*plan.reposition, dataclasses.replace(plan.reposition[0], swivel=0.0,
-                                                            length=0.0)):
+    back = dataclasses.replace(plan.reposition[0], swivel=0.0, length=0.0)
+    for segment in (*plan.reposition, back):
         if segment.swivel != swivel:
             dx, dy, dyaw = dynamics.swivel_pose_drift(p, swivel, segment.swivel)
             for f in np.linspace(0.0, 1.0, 20):
@@ -173,6 +176,8 @@ def test_a_face_too_narrow_for_the_track_is_refused_as_narrow_wherever_the_car_s
         assert caught.value.code == ErrorCode.INVALID_REQUEST
         assert 'too narrow' in caught.value.message
         assert 'max_reposition' not in caught.value.message
+        needed = float(caught.value.message.split('needs ')[1].split(' m')[0])
+        assert needed > TRACK
 
 
 def test_a_car_standing_against_the_step_is_refused_as_such():
@@ -189,3 +194,30 @@ def test_reposition_settings_are_validated():
             PlannerConfig(**{name: -0.1})
         with pytest.raises(ValueError, match=name):
             PlannerConfig(**{name: math.nan})
+
+
+def test_the_climb_drives_the_path_then_approaches_and_climbs():
+    # The system test's step, through the state machine and the kinematic car.
+    req = request(0.05, 0.3, 0.0, 1.0)
+    plan = make_plan(P, CONFIG, req)
+    machine = ClimbStateMachine(P, CONFIG, plan, req.step_distance, req.step_yaw)
+    car = KinematicCar()
+    car.place_step(req.step_height, req.step_distance, req.step_yaw)
+    names, rows = [], []
+    while machine.outcome is None and car.time < 120.0:
+        car.apply(machine.update(car.observe()))
+        if not names or names[-1] != machine.feedback.phase_name:
+            names.append(machine.feedback.phase_name)
+        if machine.step == Step.REPOSITION:
+            rows.append((car.odometry.x, car.odometry.y, car.odometry.yaw,
+                         car.swivel != 0.0))
+    assert machine.outcome.success, machine.outcome.message
+    assert names[:2] == ['APPROACH: REPOSITION', 'APPROACH']
+    # Every segment driven: turns at the swivel's limit, forwards and backwards.
+    driven = {(c.angle, math.copysign(1.0, c.drive_speed)) for c in car.commands
+              if c.drive_speed != 0.0 and abs(c.angle) == P.swivel_limit}
+    assert driven == {(s.swivel, math.copysign(1.0, s.length)) for s in plan.reposition
+                      if s.swivel != 0.0}
+    # The car stayed clear of the step while it repositioned (the planned clearance keeps
+    # room for the kinematic car's differences from the planned arcs).
+    assert gap_to_box(rows, req, 0.0) > 0.0

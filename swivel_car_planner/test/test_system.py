@@ -37,15 +37,20 @@ def stack(session):
 
 
 def test_feasible_step_is_climbed_with_all_four_wheels_on_top(stack):
-    stack.spawn_step(HEIGHT, DISTANCE, yaw=0.1)
-    response = stack.climb(HEIGHT, DISTANCE, yaw=0.1)
+    # 0.3 m ahead, square, a 1 m face: no room to turn onto the approach, and backing up
+    # straight the car would cross the edge beside the face. It repositions first.
+    distance, width = 0.3, 1.0  # [m]
+    stack.spawn_step(HEIGHT, distance, width=width)
+    response = stack.climb(HEIGHT, distance, width=width)
     assert response.success, response.message
     assert response.error_code == ClimbStep.Response.ERROR_NONE
     stack.settle(0.5)
     assert stack.four_wheels_on_top(HEIGHT), stack.truth
     assert response.plan.swivel_angle != 0.0
+    assert len(response.plan.reposition_length) >= 3
     assert 0.0 < response.outcome.peak_torque
-    assert response.outcome.distance_travelled > DISTANCE
+    assert response.outcome.distance_travelled > distance + sum(
+        abs(length) for length in response.plan.reposition_length)
     # Released: the controller takes cmd_vel again.
     assert stack.controller_state.source != 'swivel_command'
 

@@ -44,6 +44,8 @@ import numpy as np
 from swivel_car_model import climbing, dynamics, kinematics, planar
 from swivel_car_model.params import SwivelCarParams
 
+from swivel_car_planner.core.config import PlannerConfig
+
 _SAMPLE_STEP = 0.02  # [m] base_link path between two checked poses
 _SAMPLE_TURN = 0.02  # [rad] heading change between two checked poses
 _FAR = 1e3  # [m] stands for "without end" in the step's box
@@ -88,7 +90,7 @@ class StepBox:
     offset: float  # [m]
 
     def corners(self) -> np.ndarray:
-        """Return the box's four corners (4, 2) [m], 'without end' as ``_FAR``."""
+        """Return the corners of the box, shape (4, 2) [m]; "without end" is ``_FAR``."""
         nx, ny = math.cos(self.normal_yaw), math.sin(self.normal_yaw)
         half = self.width / 2.0 if self.width > 0.0 else _FAR
         low, high = self.offset - half, self.offset + half
@@ -157,7 +159,7 @@ def _drift(p: SwivelCarParams, start: float, end: float) -> tuple[float, float, 
     return tuple(float(v) for v in dynamics.swivel_pose_drift(p, start, end))
 
 
-def _curvature(p: SwivelCarParams, swivel: float) -> float:
+def path_curvature(p: SwivelCarParams, swivel: float) -> float:
     """Return base_link's curvature [1/m] at a path's swivel (0 or a tightest turn's)."""
     if swivel == 0.0:
         return 0.0
@@ -188,7 +190,7 @@ def propagate(p: SwivelCarParams, start: Pose, segments: tuple[Segment, ...],
             poses.append(pose)
         if segment.length == 0.0:
             continue
-        curvature = _curvature(p, segment.swivel)  # [1/m]
+        curvature = path_curvature(p, segment.swivel)  # [1/m]
         turn = abs(curvature * segment.length)
         count = max(1, math.ceil(max(abs(segment.length) / _SAMPLE_STEP, turn / _SAMPLE_TURN)))
         turning = segment.swivel != 0.0
@@ -248,6 +250,19 @@ def collides(p: SwivelCarParams, poses: list[Pose], box: StepBox, clearance: flo
 def reposition_length(segments: tuple[Segment, ...]) -> float:
     """Return the path's length [m]: base_link's travel, forwards and backwards."""
     return sum(abs(s.length) for s in segments)
+
+
+def reposition_time(p: SwivelCarParams, config: PlannerConfig,
+                    segments: tuple[Segment, ...]) -> float:
+    """
+    Return the time [s] the path takes: driving at ``approach_speed``, every swivel move.
+
+    Each move to a turn and back at ``swivel_rate`` plus ``settle_time`` (``config``: the
+    planner's settings).
+    """
+    moves = 2 * sum(segment.swivel != 0.0 for segment in segments)
+    return (reposition_length(segments) / (config.approach_speed * p.r)
+            + moves * (p.swivel_limit / config.swivel_rate + config.settle_time))
 
 
 def _wrap(angle: float) -> float:

@@ -20,11 +20,14 @@ from swivel_car_planner.core import steps
 from swivel_car_planner.core.codes import ErrorCode, Phase
 from swivel_car_planner.core.config import PlannerConfig
 from swivel_car_planner.core.plan import ClimbPlan
+from swivel_car_planner.core.reposition import reposition_time
 from swivel_car_planner.core.steps import Climb, Command, Finish, Observation, Step
 
 __all__ = ['ClimbStateMachine', 'Command', 'Feedback', 'Observation', 'Outcome', 'Step']
 
 _STEPS = list(Step)
+# Steps the feedback names beside their phase: the climb's rest, and the path to the approach.
+_NAMED = {Step.REPOSITION} | {step for step in Step if step.phase == Phase.CLIMB_REST}
 
 
 @dataclass(frozen=True)
@@ -75,7 +78,9 @@ class ClimbStateMachine:
         self._plan = plan
         self._step_distance = step_distance
         self._step_yaw = step_yaw
-        self._allowance = time_allowance if time_allowance > 0.0 else config.time_allowance
+        # The default allowance is the climb's: a repositioning path gets its time on top.
+        self._allowance = time_allowance if time_allowance > 0.0 else (
+            config.time_allowance + reposition_time(p, config, plan.reposition))
         self._step = Step.APPROACH
         self._climb: Climb | None = None  # from the first observation on
         self._behaviour: steps.StepBehaviour | None = None  # the step running
@@ -226,7 +231,7 @@ class ClimbStateMachine:
         failed = self.outcome is not None and not self.outcome.success
         phase = Phase.ABORTING if failed else self._step.phase
         self.feedback = Feedback(
-            phase, phase.name if failed or phase != Phase.CLIMB_REST
+            phase, phase.name if failed or self._step not in _NAMED
             else f'{phase.name}: {self._step.name}',
             self.feedback.progress if failed else self._progress(obs),
             obs.pitch, obs.roll, obs.swivel, obs.torque,
