@@ -57,7 +57,7 @@ def test_feasible_step_is_climbed_with_all_four_wheels_on_top(stack):
 
 @pytest.mark.parametrize('height, code', [
     (0.5, ClimbStep.Response.ERROR_UNREACHABLE_HEIGHT),  # beyond the lifted wheel's reach
-    (0.08, ClimbStep.Response.ERROR_UNREACHABLE_HEIGHT),  # beyond the rear axle's traction
+    (0.09, ClimbStep.Response.ERROR_UNREACHABLE_HEIGHT),  # beyond the rear axle's traction
     (-0.02, ClimbStep.Response.ERROR_INVALID_REQUEST)])
 def test_infeasible_step_is_refused_without_motion(stack, height, code):
     if height > 0.0:
