@@ -5,11 +5,14 @@ The routes run in pybullet; ours (tricycle with a variable offset steering wheel
 plain tricycle.
 
     python -m swivel_car_control.benchmark [--routes straight_5m,turn_on_the_spot]
+        [--sensor-profiles ideal,realistic] [--seed 0]
 
 Runs the sim's physics (``swivel_car_sim.physics.SwivelCarSim``, the same class ``sim_node``
 wraps) in lockstep with the controller core and the odometry integrators in one process, so
 the figures are deterministic and independent of machine load (every route also runs through
-the real node executables in ``test/test_system_routes.py``). Prints; asserts nothing.
+the real node executables in ``test/test_system_routes.py``). Each route runs with the sim's
+ideal sensors and with its realistic ones (``swivel_car_sim.sensor_models``: quantised
+encoders, lost states and commands, command latency), seeded. Prints; asserts nothing.
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ from swivel_car_model.description import CarDescription
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_model.planar import arc_step, curvature_for_swivel, OffsetTricycleOdometry
 from swivel_car_sim.physics import SimConfig, SwivelCarSim
+from swivel_car_sim.sensor_models import DelayedCommands, SensorProfile, SensorSuite
 
 CONTROL_PERIOD = 0.01  # [s], as the sim node's default
 SWIVEL, REAR_LEFT, REAR_RIGHT = 0, 1, 2  # joint order of SwivelCarSim.state()
@@ -119,11 +123,16 @@ class ClosedLoop:
     description : CarDescription
         The robot (default: the stack's).
     config : ControllerConfig
+    sensors : SensorProfile, optional
+        The sim's sensors and links (default: ideal).
+    seed : int
+        Of the sensor models' draws.
 
     """
 
     def __init__(self, description: CarDescription | None = None,
-                 config: ControllerConfig | None = None) -> None:
+                 config: ControllerConfig | None = None,
+                 sensors: SensorProfile | None = None, seed: int = 0) -> None:
         description = description or CarDescription()
         self.p = description.model_params()
         self.config = config or ControllerConfig(cmd_vel_timeout=0.0,
@@ -135,6 +144,9 @@ class ClosedLoop:
         self.rear_odometry = OffsetTricycleOdometry(self.p)
         self.plain = PlainTricycleOdometry(self.p)
         self._last_time: float | None = None
+        self.sensors = (None if sensors is None or sensors.ideal
+                        else SensorSuite(sensors, seed, self.sim.state()))
+        self._commands = DelayedCommands(self.sim.config.time_step)
 
     def close(self) -> None:
         self.sim.close()
@@ -143,22 +155,34 @@ class ClosedLoop:
         """
         Run one control period: measure, update the odometries, command, step the physics.
 
-        Returns (state measured, controller output).
+        Returns (true state, controller output; None: the state was lost on its way).
         """
         state = self.sim.state()
+        positions, velocities = state.positions, state.velocities
+        if self.sensors is not None:
+            sample = self.sensors.sample(state)
+            if sample.lost:  # nobody hears it: the board goes on with the command it has
+                self._commands.step(self.sim, self.steps_per_period, self.sim.set_command)
+                return state, None
+            positions, velocities = sample.positions, sample.velocities
         theta2 = max(-self.p.max_swivel_angle, min(self.p.max_swivel_angle,
-                                                   float(state.positions[SWIVEL])))
-        rate = float(state.velocities[SWIVEL])
-        left, right = float(state.velocities[REAR_LEFT]), float(state.velocities[REAR_RIGHT])
+                                                   float(positions[SWIVEL])))
+        rate = float(velocities[SWIVEL])
+        left, right = float(velocities[REAR_LEFT]), float(velocities[REAR_RIGHT])
         rear = 0.5 * (left + right)
         dt = 0.0 if self._last_time is None else state.time - self._last_time
         self._last_time = state.time
         self.odometry.update(theta2, rate, rear, dt)
         self.rear_odometry.update(theta2, rate, rear, dt, right - left)
         self.plain.update(theta2, rear, dt)
-        out = self.controller.step(state.time, float(state.positions[SWIVEL]), rate)
-        self.sim.set_command(out.swivel_torque, out.drive_speed)
-        self.sim.step(self.steps_per_period)
+        out = self.controller.step(state.time, float(positions[SWIVEL]), rate)
+        command = (out.swivel_torque, out.drive_speed)
+        if self.sensors is None:
+            self.sim.set_command(*command)
+        elif not self.sensors.transport.lost():
+            self._commands.push(self.sim.steps, self.sensors.transport.command_delay(),
+                                command)
+        self._commands.step(self.sim, self.steps_per_period, self.sim.set_command)
         return state, out
 
     def drive(self, name: str, segments: list[Segment], settle: float = 1.0) -> RouteResult:
@@ -199,34 +223,44 @@ class ClosedLoop:
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--routes', default='', help='comma-separated subset of the routes')
+    parser.add_argument('--sensor-profiles', default='ideal,realistic',
+                        help="comma-separated: 'ideal', 'realistic' or profile YAML paths")
+    parser.add_argument('--seed', type=int, default=0, help="the sensor models' seed")
     args = parser.parse_args(argv)
     description = CarDescription()
     chosen = routes(description.model_params())
     if args.routes:
         chosen = {name: chosen[name] for name in args.routes.split(',')}
+    try:
+        profiles = [SensorProfile.load(name) for name in args.sensor_profiles.split(',')]
+    except ValueError as error:
+        parser.error(str(error))
     print('end-pose error vs ground truth: position as % of the distance travelled, heading '
           '[rad]\n  ours      = tricycle with a variable offset steering wheel (planar.py)\n'
           '  rear yaw  = ours, yaw rate from the rear wheel rate difference\n'
           '  plain     = tricycle without offset: omega = v tan(delta) / wheelbase')
-    print(f'{"route":25s} {"dist m":>7s} {"turn rad":>8s} | {"ours %":>7s} {"yaw":>6s} | '
-          f'{"rear yaw %":>10s} {"yaw":>6s} | {"plain %":>7s} {"yaw":>6s} | wall s')
+    print(f"  sensors   = the sim's ideal ones, or a profile's (seed {args.seed})")
+    print(f'{"route":25s} {"sensors":>9s} {"dist m":>7s} {"turn rad":>8s} | {"ours %":>7s} '
+          f'{"yaw":>6s} | {"rear yaw %":>10s} {"yaw":>6s} | {"plain %":>7s} {"yaw":>6s} | wall s')
     for name, segments in chosen.items():
-        loop = ClosedLoop(description)
-        wall = time.monotonic()
-        try:
-            result = loop.drive(name, segments)
-        finally:
-            loop.close()
-        wall = time.monotonic() - wall
-        cells = []
-        for width, (position, heading) in ((7, result.ours), (10, result.rear),
-                                           (7, result.plain)):
-            cells.append(f'{RouteResult.percent(position, result.distance):{width}.3f} '
-                         f'{heading:6.4f}')
-        print(f'{name:25s} {result.distance:7.3f} {result.turned:8.3f} | ' + ' | '.join(cells)
-              + f' | {wall:6.1f}'
-              + (f'   (abs: ours {result.ours[0]:.4f} m, rear yaw {result.rear[0]:.4f} m, '
-                 f'plain {result.plain[0]:.4f} m)' if result.distance < 0.5 else ''))
+        for profile in profiles:
+            loop = ClosedLoop(description, sensors=profile, seed=args.seed)
+            wall = time.monotonic()
+            try:
+                result = loop.drive(name, segments)
+            finally:
+                loop.close()
+            wall = time.monotonic() - wall
+            cells = []
+            for width, (position, heading) in ((7, result.ours), (10, result.rear),
+                                               (7, result.plain)):
+                cells.append(f'{RouteResult.percent(position, result.distance):{width}.3f} '
+                             f'{heading:6.4f}')
+            sensors = profile.name if len(profile.name) <= 9 else '...' + profile.name[-6:]
+            print(f'{name:25s} {sensors:>9s} {result.distance:7.3f} {result.turned:8.3f} | '
+                  + ' | '.join(cells) + f' | {wall:6.1f}'
+                  + (f'   (abs: ours {result.ours[0]:.4f} m, rear yaw {result.rear[0]:.4f} m, '
+                     f'plain {result.plain[0]:.4f} m)' if result.distance < 0.5 else ''))
 
 
 if __name__ == '__main__':

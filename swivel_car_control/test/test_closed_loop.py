@@ -13,6 +13,7 @@ import pytest
 from swivel_car_control.benchmark import ClosedLoop, routes
 from swivel_car_control.core.controller import ControllerConfig
 from swivel_car_model.description import CarDescription
+from swivel_car_sim.sensor_models import SensorProfile
 
 
 @pytest.fixture
@@ -136,3 +137,21 @@ def test_odometry_on_standard_routes(name):
     assert result.rear[0] / result.distance < 0.015
     if name == 'turn_on_the_spot':
         assert result.ours[1] < 0.3 * result.plain[1]
+
+
+@pytest.mark.parametrize('name', ['circle_swivel_1.1', 'turn_on_the_spot'])
+def test_odometry_holds_with_the_realistic_sensors(name):
+    """
+    The odometry on quantised encoders, with lost states and late commands (seeded).
+
+    The two routes where the odometry's error is largest with ideal sensors (0.69 % and
+    0.63 %): with the realistic profile it must stay within the issue's 1 % of the distance
+    (measured 0.67 % and 0.62 %: tick differences are exact over their interval).
+    """
+    loop = ClosedLoop(sensors=SensorProfile.load('realistic'), seed=0)
+    try:
+        result = loop.drive(name, routes(loop.p)[name])
+    finally:
+        loop.close()
+    assert result.distance > 1.0
+    assert result.ours[0] / result.distance < 0.01

@@ -37,7 +37,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import numpy as np
 import yaml
@@ -551,3 +551,18 @@ class DelayedCommands:
     def clear(self) -> None:
         """Forget the commands on their way (a sim reset)."""
         self._queue.clear()
+
+    def step(self, sim: Any, steps: int, apply: Callable[[float, float], Any]) -> None:
+        """
+        Step ``sim`` (a SwivelCarSim) ``steps`` physics steps, each command applied when due.
+
+        ``apply(swivel_torque, drive_speed)`` gives a command to the physics.
+        """
+        end = sim.steps + steps
+        while True:
+            for command in self.due(sim.steps):
+                apply(*command)
+            if sim.steps >= end:
+                return
+            due = self.next_step()
+            sim.step((end if due is None else min(end, max(due, sim.steps + 1))) - sim.steps)

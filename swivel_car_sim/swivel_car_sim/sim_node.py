@@ -137,15 +137,7 @@ class SimNode(Node):
 
     def _step_physics(self, steps: int) -> None:
         """Step the physics, applying each delayed command at its physics step."""
-        end = self.sim.steps + steps
-        while True:
-            for command in self._commands.due(self.sim.steps):
-                self._apply(*command)
-            if self.sim.steps >= end:
-                return
-            due = self._commands.next_step()
-            self.sim.step((end if due is None else min(end, max(due, self.sim.steps + 1)))
-                          - self.sim.steps)
+        self._commands.step(self.sim, steps, self._apply)
 
     def _advance(self) -> None:
         """One control period of physics, then publish the new state."""
