@@ -105,6 +105,7 @@ bench: build
 	$(IN_WS) python -m swivel_car_bringup.benchmark
 	$(IN_WS) python -m swivel_car_bringup.campaign_benchmark
 	$(IN_WS) python -m swivel_car_bringup.climb_benchmark $(CLIMB_BENCH_ARGS)
+	$(IN_WS) python -m swivel_car_bringup.detected_climb_benchmark
 
 # Ten minutes of driving and climbs through the ROS stack: memory slope and message rates.
 soak: build

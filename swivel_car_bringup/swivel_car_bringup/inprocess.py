@@ -37,12 +37,14 @@ import time
 from typing import Any, Callable, Mapping
 
 import numpy as np
+from swivel_car_bringup.inprocess_detection import InProcessDetection
 from swivel_car_control.core.controller import ControllerConfig, ControlOutput, SwivelController
 from swivel_car_control.core.joint_states import (
     JointStateController, JointStateOdometry, yaw_quaternion)
 from swivel_car_control.joints import MissingJointError
 from swivel_car_model import description
 from swivel_car_model.description import CarDescription
+from swivel_car_perception.core.fusion import Pose2D
 from swivel_car_planner.core import (
     capability, ClimbPlan, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs,
     make_plan, Outcome, PlanError, PlannerConfig, validate_request)
@@ -382,6 +384,8 @@ class InProcessStack:
         self.timings: dict[str, list[float]] = {}  # name -> [total wall s, count]
         self.refused_commands: list[str] = []  # swivel commands the controller refused
         self._rows: list[tuple] = []
+        # The depth camera and the step detector, once ``enable_detection`` is called.
+        self.detection: InProcessDetection | None = None
         self._start_nodes()
 
     def _start_nodes(self) -> None:
@@ -396,6 +400,7 @@ class InProcessStack:
         self._sync = InputSync(inputs.INPUTS, inputs.CONTROLLER_STATE)
         self._command_heard = -math.inf  # [s] stamp of the last swivel_command
         self.machine: ClimbStateMachine | None = None
+        self._detected_climb = False  # the running climb follows the detector
         self._steps: list[tuple[float, str]] = []
         self._cmd_vel: tuple[float, float] | None = None
         self.last_output: ControlOutput | None = None
@@ -536,6 +541,11 @@ class InProcessStack:
             ticks += self._sync.add(inputs.CONTROLLER_STATE, t, inputs.controller_state_values(
                 out.set_point, out.swivel_torque, self._command_heard, swivel.position,
                 swivel.rate))
+        if self.detection is not None:
+            o = self.odometry.odometry
+            self.detection.period(self._periods, t, state,
+                                  Pose2D(o.x, o.y, o.yaw) if odom_due else None,
+                                  self.machine is not None)
         for tick in ticks:
             self._on_tick(tick)
 
@@ -550,7 +560,11 @@ class InProcessStack:
         machine = self.machine
         if machine is None:
             return
-        commands = [self._timed('state_machine', machine.update, inputs.observation(tick))]
+        observation = inputs.observation(tick)
+        commands = [self._timed('state_machine', machine.update, observation)]
+        if self.detection is not None:
+            self.detection.planner.follow(machine, observation, tick.time,
+                                          self._detected_climb)
         if not self._steps or self._steps[-1][1] != machine.step.name:
             self._steps.append((tick.time, machine.step.name))
         if machine.outcome is not None:
@@ -605,7 +619,12 @@ class InProcessStack:
         finally:
             self._cmd_vel = None
 
-    def climb(self, request: ClimbRequest) -> ClimbResult:
+    def enable_detection(self, seed: int = 0) -> None:
+        """Put the depth camera on and run the step detector on it, as the ROS stack does."""
+        self.detection = InProcessDetection(self.sim, self.config.robot, self.control_period,
+                                            seed)
+
+    def climb(self, request: ClimbRequest, use_detected_step: bool = False) -> ClimbResult:
         """
         Ask the planner to climb, as planner_node's climb_step does.
 
@@ -620,6 +639,9 @@ class InProcessStack:
         request : ClimbRequest
             step_height [m], step_distance [m] (front axle contact to the edge), step_yaw
             [rad], plan_only, time_allowance [s] (0: the planner's default).
+        use_detected_step : bool
+            Climb the detector's latest detection instead of the request's step (needs
+            ``enable_detection``), as planner_node does.
 
         Returns
         -------
@@ -628,6 +650,14 @@ class InProcessStack:
         """
         start, first_row = self.time, len(self._rows)
         self._steps = []
+        self._detected_climb = use_detected_step
+        if use_detected_step:
+            detected, why = (self.detection.planner.request(request, start)
+                             if self.detection is not None
+                             else (None, 'the depth camera is off (enable_detection)'))
+            if detected is None:
+                return self._result(False, ErrorCode.NO_STEP_DETECTED, why, None, None, start)
+            request = detected
         code, message = validate_request(request, self.config.planner)
         if code != ErrorCode.NONE:
             return self._result(False, code, message, None, None, start)

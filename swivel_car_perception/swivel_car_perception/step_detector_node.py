@@ -22,7 +22,7 @@ from swivel_car_perception.core.detector import (
     Detection, DetectorConfig, Mount, StepDetector)
 from swivel_car_perception.core.fusion import Pose2D, StepTracker
 from swivel_car_perception.core.image import depth_from_fields, intrinsics_from_camera_info
-from swivel_car_perception.core.poses import PoseHistory
+from swivel_car_perception.core.perception import StepPerception
 from swivel_car_ros.ros_params import declare_dataclass, declare_description, run_node
 from visualization_msgs.msg import Marker, MarkerArray
 
@@ -36,7 +36,7 @@ class StepDetectorConfig:
     """The node's parameters (see CONFIG_DESCRIPTIONS)."""
 
     base_frame_id: str = 'base_link'
-    min_height: float = 0.02  # [m]
+    min_height: float = 0.012  # [m]
     max_distance: float = 1.6  # [m]
     max_lateral: float = 2.0  # [m]
     odom_drift: float = 0.02  # [1]
@@ -82,9 +82,8 @@ class StepDetectorNode(Node):
             min_height=config.min_height, max_distance=config.max_distance,
             max_lateral=config.max_lateral)
         self._detector: StepDetector | None = None
-        self._tracker = StepTracker(robot.wheelbase, config.odom_drift, config.gate,
-                                    int(config.max_misses))
-        self._poses = PoseHistory()
+        self._perception = StepPerception(None, StepTracker(
+            robot.wheelbase, config.odom_drift, config.gate, int(config.max_misses)))
         self._next_refusal: dict[str, float] = {}  # kind -> wall time [s] its next line is due
         self._step_pub = self.create_publisher(DetectedStep, 'detected_step', 10)
         self._marker_pub = self.create_publisher(MarkerArray, '~/markers', 10)
@@ -106,16 +105,14 @@ class StepDetectorNode(Node):
             return
         if self._detector is None or self._detector.intrinsics != intrinsics:
             self._detector = StepDetector(intrinsics, self._mount, self._detector_config)
+            self._perception.detector = self._detector
 
     def _on_odom(self, odom: Odometry) -> None:
         q = odom.pose.pose.orientation
         yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
         stamp = odom.header.stamp.sec * 1_000_000_000 + odom.header.stamp.nanosec
-        latest = self._poses.latest
-        if latest is not None and stamp < latest[0]:
-            self._tracker.reset()  # odometry (or the sim) started again
-        self._poses.add(stamp, Pose2D(odom.pose.pose.position.x, odom.pose.pose.position.y,
-                                      yaw))
+        self._perception.odom(stamp, Pose2D(odom.pose.pose.position.x,
+                                            odom.pose.pose.position.y, yaw))
 
     def _on_image(self, image: Image) -> None:
         if self._detector is None:
@@ -128,12 +125,9 @@ class StepDetectorNode(Node):
         except ValueError as error:
             self._refuse(f'refusing depth image: {error}')
             return
-        detection = self._detector.detect(depth)
         stamp = image.header.stamp.sec * 1_000_000_000 + image.header.stamp.nanosec
-        pose = self._poses.at(stamp)
-        if pose is not None:
-            detection = self._tracker.update(detection, pose)
-        elif detection.found:
+        detection, fused = self._perception.frame(depth, stamp)
+        if not fused and detection.found:
             self.get_logger().warn('no odom at the image stamps: each frame on its own, '
                                    'unfused', throttle_duration_sec=10.0)
         if not detection.found:

@@ -37,8 +37,15 @@ def test_a_detected_step_is_climbed_with_all_four_wheels_on_top():
         session.spin_until(lambda: detections and detections[-1].found, 60.0 + LOCKSTEP_TIMEOUT,
                            'a detection of the step')
         seen = detections[-1]
-        response = session.call(session.climb_client, ClimbStep.Request(use_detected_step=True),
-                                timeout=CLIMB_WALL_LIMIT)
+        # The planner takes the detections on its own executor: under load the request can
+        # come before it has taken one (refused, nothing moved); asked again then.
+        for _ in range(20):
+            response = session.call(session.climb_client,
+                                    ClimbStep.Request(use_detected_step=True),
+                                    timeout=CLIMB_WALL_LIMIT)
+            if not response.message.startswith('no detected_step heard'):
+                break
+            session.settle(0.2)
         assert response.success, response.message
         session.settle(0.5)
         assert session.four_wheels_on_top(HEIGHT), session.truth

@@ -43,7 +43,7 @@ from swivel_car_planner.conversions import (
     controller_state_fields, imu_fields, odom_fields, outcome_to_msg, plan_to_msg, request_from)
 from swivel_car_planner.core import (
     capability, ClimbPlan as Plan, ClimbRequest, ClimbStateMachine, Command, ErrorCode, inputs,
-    make_plan, Phase, PlanError, PlannerConfig, validate_request)
+    make_plan, PlanError, PlannerConfig, validate_request)
 from swivel_car_planner.core.detected import DetectedSteps
 from swivel_car_planner.core.liveness import ClimbSlot, InputLiveness
 from swivel_car_planner.core.sync import InputSync, Tick
@@ -448,25 +448,11 @@ class PlannerNode(Node):
             self._end(climb, tick.time)
 
     def _follow_detection(self, machine: ClimbStateMachine, obs, stamp: float) -> None:
-        """
-        Note the pose the climb steers by; in the approach, move its edge to a new detection.
-
-        The climb's heading is the IMU's (odometry's drifts while the swivel turns at a
-        standstill), so the detections are placed with the climb's own poses.
-        """
-        climb = machine.climb
-        if climb is None:
-            return
-        self._detected.pose(stamp, obs.x, obs.y, climb.heading(obs))
-        if machine.phase != Phase.APPROACH or not self._slot.climb.use_detected_step:
-            return
-        edge = self._detected.correction(climb.edge, stamp)
-        if edge is not None:
-            shift = climb.edge.signed_distance(edge.px, edge.py)
-            turn = edge.normal_yaw - climb.edge.normal_yaw
-            climb.edge = edge
-            self.get_logger().info(f'approach: the detected edge is {shift:+.3f} m and '
-                                   f'{turn:+.3f} rad from the planned one: following it')
+        """Note the climb's pose; in a detected climb's approach, follow new detections."""
+        moved = self._detected.follow(machine, obs, stamp, self._slot.climb.use_detected_step)
+        if moved is not None:
+            self.get_logger().info(f'approach: the detected edge is {moved[0]:+.3f} m and '
+                                   f'{moved[1]:+.3f} rad from the planned one: following it')
 
     def _detected_step_msg(self, stamp: float) -> DetectedStep:
         """Return the latest fresh detection relative to base_link now (found false: none)."""

@@ -1,5 +1,6 @@
 """climb_step on a detected step: the core (freshness, odometry, corrections) and the node."""
 
+from dataclasses import replace
 import math
 import os
 
@@ -11,7 +12,7 @@ from swivel_car_msgs.msg import DetectedStep
 from swivel_car_msgs.srv import ClimbStep
 from swivel_car_perception.core.detector import Detection
 from swivel_car_planner.core import ClimbRequest, ErrorCode
-from swivel_car_planner.core.detected import DetectedSteps
+from swivel_car_planner.core.detected import DetectedSteps, UNSEEN_REACH
 from swivel_car_planner.core.geometry import Pose2D, StepEdge
 from swivel_car_planner.planner_node import PlannerNode
 from swivel_car_testing import next_domain_id, spin_until
@@ -35,6 +36,20 @@ def test_a_fresh_detection_moved_to_the_present_pose():
     assert (request.step_height, request.step_width, request.step_offset) == \
         pytest.approx((0.05, 1.2, 0.1))
     assert request.step_distance == pytest.approx(0.8) and request.step_yaw == 0.0
+
+
+def test_an_end_not_seen_lies_beyond_what_was_seen():
+    steps = DetectedSteps(FRONT_AXLE, max_age=0.5)
+    steps.pose(10.0, 0.0, 0.0, 0.0)
+    one_end = replace(_step(yaw=0.0), right_end_seen=False)  # seen from -0.5 to 0.7 m
+    steps.heard(10.0, one_end)
+    request, _ = steps.request(ClimbRequest(0.0, 0.0, 0.0), now=10.1)
+    assert request.step_offset + request.step_width / 2.0 == pytest.approx(0.7)
+    assert request.step_offset - request.step_width / 2.0 == pytest.approx(-0.5 - UNSEEN_REACH)
+    steps.pose(10.1, 0.0, 0.0, 0.0)
+    steps.heard(10.1, replace(one_end, left_end_seen=False))
+    request, _ = steps.request(ClimbRequest(0.0, 0.0, 0.0), now=10.1)
+    assert request.step_width == 0.0  # not known: the planner only holds its heading
 
 
 @pytest.mark.parametrize('setup, words', [
@@ -63,6 +78,9 @@ def test_the_approach_follows_a_detection_beyond_its_uncertainty_once():
     # The old point dropped onto the new line: the plan's crossing keeps its place.
     assert planned.along(moved.px, moved.py) == pytest.approx(0.0, abs=1e-12)
     assert steps.correction(moved, 1.2) is None  # used once
+    steps.heard(1.2, _step(distance=0.3))  # 0.7 m off, but where the front wheels hide it
+    steps.pose(1.2, 0.0, 0.0, 0.0)
+    assert steps.correction(moved, 1.2) is None
 
 
 def test_the_planner_node_refuses_use_detected_step_without_a_detector():

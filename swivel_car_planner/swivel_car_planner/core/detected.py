@@ -16,9 +16,18 @@ import math
 from swivel_car_perception.core.detector import Detection
 from swivel_car_perception.core.fusion import moved, Pose2D as OdomPose
 from swivel_car_perception.core.poses import PoseHistory
+from swivel_car_planner.core.codes import Phase
 from swivel_car_planner.core.geometry import Pose2D, StepEdge, wrap_angle
 from swivel_car_planner.core.request import ClimbRequest
+from swivel_car_planner.core.state_machine import ClimbStateMachine, Observation
 
+# An end of the edge the camera did not see lies somewhere beyond what it saw: the request's
+# face reaches this far on that side: beyond any crossing the approach can reach.
+UNSEEN_REACH = 2.0  # [m] (the offset stays within the request's 3 m)
+# Nearer than this to the front axle, the front wheels (swung by the swivel while the car
+# turns onto its approach) hide parts of the riser: the edge's yaw jumped by 0.05-0.07 rad
+# between frames there (detected climb benchmark), so such detections correct nothing.
+MIN_FOLLOW_DISTANCE = 0.35  # [m]
 # Smallest edge move that counts as one, whatever the detection's uncertainty: the odometry's
 # own jitter between two frames.
 MIN_SHIFT = 0.003  # [m]
@@ -79,26 +88,37 @@ class DetectedSteps:
         return moved(detection, then, latest[1], self.front_axle), ''
 
     def request(self, request: ClimbRequest, now: float) -> tuple[ClimbRequest | None, str]:
-        """Return ``request`` with the fresh detection's step, or None and why (one line)."""
-        detection, why = self.fresh(now)
-        if detection is None:
+        """
+        Return ``request`` with the fresh detection's step, or None and why (one line).
+
+        An end the camera did not see is taken ``UNSEEN_REACH`` beyond the part it saw;
+        neither end seen: the width is not known (0).
+        """
+        d, why = self.fresh(now)
+        if d is None:
             return None, why
-        return replace(request, step_height=detection.height,
-                       step_distance=max(0.0, detection.distance), step_yaw=detection.yaw,
-                       step_width=detection.width, step_offset=detection.offset), ''
+        left = d.offset + d.width / 2.0 + (0.0 if d.left_end_seen else UNSEEN_REACH)  # [m]
+        right = d.offset - d.width / 2.0 - (0.0 if d.right_end_seen else UNSEEN_REACH)
+        if not (d.left_end_seen or d.right_end_seen):
+            left = right = 0.0
+        return replace(request, step_height=d.height, step_distance=max(0.0, d.distance),
+                       step_yaw=d.yaw, step_width=left - right,
+                       step_offset=(left + right) / 2.0), ''
 
     def correction(self, edge: StepEdge, now: float) -> StepEdge | None:
         """
         Return the edge a new fresh detection puts elsewhere than ``edge``, or None.
 
-        Elsewhere: more than twice its one-sigma distance or yaw uncertainty away. The poses
+        Elsewhere: more than twice its one-sigma distance or yaw uncertainty away; only a
+        detection at least ``MIN_FOLLOW_DISTANCE`` ahead of the front axle counts. The poses
         must be in ``edge``'s frame. The returned edge keeps ``edge``'s point's place along
         the edge (the plan's crossing is measured from it). A detection corrects at most once.
         """
         if self._latest is None:
             return None
         stamp, d = self._latest
-        if not d.found or now - stamp > self.max_age or stamp <= self._used:
+        if (not d.found or now - stamp > self.max_age or stamp <= self._used
+                or d.distance < MIN_FOLLOW_DISTANCE):
             return None
         then = self.poses.at(round(stamp * 1e9))
         if then is None:
@@ -115,3 +135,28 @@ class DetectedSteps:
         gap = seen.signed_distance(edge.px, edge.py)
         return StepEdge(edge.px - gap * math.cos(seen.normal_yaw),
                         edge.py - gap * math.sin(seen.normal_yaw), seen.normal_yaw)
+
+    def follow(self, machine: ClimbStateMachine, obs: Observation, stamp: float,
+               correct: bool) -> tuple[float, float] | None:
+        """
+        Note the pose the climb steers by; with ``correct``, follow a new detection.
+
+        The climb's heading is the IMU's (odometry's drifts while the swivel turns at a
+        standstill), so the detections are placed with the climb's own poses. In the
+        approach, a new detection beyond its uncertainty becomes the climb's edge. Returns
+        how far (along the old normal [m]) and by how much (turn [rad]) the edge moved, or
+        None.
+        """
+        climb = machine.climb
+        if climb is None:
+            return None
+        self.pose(stamp, obs.x, obs.y, climb.heading(obs))
+        if not correct or machine.phase != Phase.APPROACH:
+            return None
+        edge = self.correction(climb.edge, stamp)
+        if edge is None:
+            return None
+        moved_by = (climb.edge.signed_distance(edge.px, edge.py),
+                    wrap_angle(edge.normal_yaw - climb.edge.normal_yaw))
+        climb.edge = edge
+        return moved_by
