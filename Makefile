@@ -89,7 +89,7 @@ test: build $(FOXGLOVE_NPM)
 
 demo: build
 	@echo '== running the demo: the simulated car drives to a step and climbs it'
-	$(IN_WS) python scripts/demo.py
+	$(IN_WS) python scripts/demo.py $(if $(CLOCK),--clock $(CLOCK))
 
 figures: build
 	$(IN_WS) python -m swivel_car_model.figures --out docs/figures

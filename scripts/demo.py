@@ -60,14 +60,19 @@ NODE_PARAMETERS = {executable: {'use_sim_time': True,
                                 **lockstep_parameters(executable, LOCKSTEP_TIMEOUT)}
                    for _, executable in NODES}
 NODE_PARAMETERS['sim_node']['gui'] = False
+# As the robot runs (--clock wall, `make demo CLOCK=wall`): the sim stamps with the system
+# clock and has the hardware's sensors and links, no /clock, no lockstep, every node on the
+# system clock (stack.launch.py clock_source:=wall sensor_profile:=realistic).
+WALL_PARAMETERS = {executable: {'use_sim_time': False} for _, executable in NODES}
+WALL_PARAMETERS['sim_node'].update(gui=False, clock_source='wall', sensor_profile='realistic')
 
 
 class DemoNode(Node):
     """The user's side of the demo: records, spawns the step, drives, asks for the climb."""
 
-    def __init__(self, context) -> None:
+    def __init__(self, context, use_sim_time: bool = True) -> None:
         super().__init__('demo', context=context,
-                         parameter_overrides=[Parameter('use_sim_time', value=True)])
+                         parameter_overrides=[Parameter('use_sim_time', value=use_sim_time)])
         self.recording = Recording()
         self.create_subscription(Odometry, 'ground_truth/odom', self._on_truth, 100)
         self.create_subscription(Odometry, 'odom', self._on_odom, 100)
@@ -158,15 +163,19 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
     # Beside the stack, as `stack.launch.py record:=true` starts them: the robot model on the
     # graph and the recorder.
     shutil.rmtree(args.report / 'bag', ignore_errors=True)
+    sim_time = args.clock == 'sim'
+    parameters = NODE_PARAMETERS if sim_time else WALL_PARAMETERS
     processes = [NodeProcess('swivel_car_bringup', 'recorder_node', domain_id, {
-        'use_sim_time': True, 'output': str(args.report / 'bag'), 'discovery_period': 0.2}),
+        'use_sim_time': sim_time, 'output': str(args.report / 'bag'),
+        'discovery_period': 0.2}),
                  NodeProcess('swivel_car_bringup', 'robot_description_node', domain_id,
-                             {'use_sim_time': True})]
-    processes += [start_node(package, executable, domain_id, NODE_PARAMETERS[executable])
+                             {'use_sim_time': sim_time})]
+    processes += [start_node(package, executable, domain_id, parameters[executable])
                   for package, executable in NODES]
+    recorded = RECORDED if sim_time else tuple(t for t in RECORDED if t != '/clock')
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)
-    node = DemoNode(context)
+    node = DemoNode(context, sim_time)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     wall_start = time.monotonic()
@@ -180,9 +189,11 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
         progress.show('start', 'the stack: sim, controller, odometry, planner, recorder')
         spin_until(executor, lambda: check_alive() or (
             node.spawn.service_is_ready() and node.climb.server_is_ready()
-            and node.recording.odom and node.recorded(RECORDED)), 90.0,
+            and node.recording.odom and node.recorded(recorded)), 90.0,
             'the stack and the recorder to come up')
 
+        # [s] the times shown count from here on the system clock; sim time counts from 0.
+        t0 = 0.0 if sim_time else node.recording.truth[0][0]
         step = demo_step(args)
         obstacle = StepObstacle(name=step.name, height=step.height, depth=step.depth,
                                 width=step.width, distance=step.distance, yaw=step.yaw,
@@ -201,7 +212,7 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
             check_alive()
             node.drive(args.drive_speed)
             progress.show('drive', f'towards the step: {args.step_distance - travelled():.2f} m '
-                                   f'to go, t = {node.recording.odom[-1][0]:.1f} s')
+                                   f'to go, t = {node.recording.odom[-1][0] - t0:.1f} s')
             spin_until(executor, lambda n=len(node.recording.odom): len(
                 node.recording.odom) > n + 4, 30.0, 'odometry while driving')
         stopped_at = len(node.recording.truth)
@@ -228,7 +239,8 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
         sent = node.climb.send_goal_async(goal, feedback_callback=lambda f: progress.show(
             f.feedback.phase_name, f'{100 * f.feedback.progress:3.0f} %  swivel '
             f'{f.feedback.swivel_angle:+.2f} rad  pitch {f.feedback.pitch:+.2f} rad  torque '
-            f'{f.feedback.swivel_torque:+5.1f} N m, t = {node.recording.truth[-1][0]:.1f} s'))
+            f'{f.feedback.swivel_torque:+5.1f} N m, '
+            f't = {node.recording.truth[-1][0] - t0:.1f} s'))
         spin_until(executor, lambda: check_alive() or sent.done(), 30.0, 'goal acceptance')
         if not sent.result().accepted:
             raise DemoError('the planner rejected the climb goal')
@@ -278,7 +290,7 @@ def summarise(args, recording: Recording, result, climb_start: float, climb_end:
         'message': result.message,
         'step_height': args.step_height,
         'climb_time': climb_end - climb_start,
-        'sim_time': float(truth[-1, 0]),
+        'sim_time': float(truth[-1, 0] - (0.0 if args.clock == 'sim' else truth[0, 0])),
         'wall_time': wall_time,
         'peak_torque': result.outcome.peak_torque,
         'energy': result.outcome.energy,
@@ -308,6 +320,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--wall-timeout', type=float, default=900.0, help='[s]')
     parser.add_argument('--domain-id', type=int, default=60 + os.getpid() % 40)
     parser.add_argument('--report', type=Path, default=REPO_ROOT / 'report')
+    parser.add_argument('--clock', choices=('sim', 'wall'), default='sim',
+                        help='sim: on sim time in lockstep (deterministic); wall: as the robot '
+                        'runs, the system clock, realistic sensors, no lockstep')
     args = parser.parse_args(argv)
     if args.step_height is None:
         table, _ = capability.table_for(capability.INSTALLED)

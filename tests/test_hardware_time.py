@@ -1,0 +1,125 @@
+"""
+The stack as it runs on the robot: system clock, realistic sensors, no lockstep.
+
+The one wall-time test of the suite, because the robot runs on wall time. The installed
+executables, as launched for hardware (``stack.launch.py clock_source:=wall``): the sim with
+``clock_source:=wall sensor_profile:=realistic`` (stamps from the system clock, no /clock,
+quantised encoders, the fused IMU's drift, lost messages and late commands), and every node
+with ``use_sim_time:=false`` and no lockstep chain. The car drives by ``cmd_vel``, then climbs
+a 5 cm step by ``climb_step``; ground truth judges.
+
+Bounds and a loaded machine: nothing here waits for another process in step, so the physics
+does not depend on the load except through the controller's answers arriving late. What is
+asserted is physical (the car moved forward, all four wheels on top, level), never a time.
+The timeouts are guards against a hang, sized for a machine shared by several test workers:
+the sim skips ahead when it is more than 0.1 s behind the system clock, so a climb of about
+15 s of sim time takes about 15 s of wall time whatever the load.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+
+from geometry_msgs.msg import TwistStamped
+from nav_msgs.msg import Odometry
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from swivel_car_model.params import SwivelCarParams
+from swivel_car_msgs.msg import StepObstacle
+from swivel_car_msgs.srv import ClimbStep, SpawnObstacle
+from swivel_car_planner.ground_truth import GroundTruth
+from swivel_car_stack import process_report, spin_until, start_node
+from swivel_car_testing import next_domain_id
+
+HARDWARE = {'use_sim_time': False}
+NODES = (('swivel_car_sim', 'sim_node', {**HARDWARE, 'clock_source': 'wall',
+                                         'sensor_profile': 'realistic', 'sensor_seed': 1}),
+         ('swivel_car_control', 'controller_node', HARDWARE),
+         ('swivel_car_control', 'odometry_node', HARDWARE),
+         ('swivel_car_planner', 'planner_node', HARDWARE))
+STEP_HEIGHT = 0.05  # [m]
+STEP_DISTANCE = 1.0  # [m] from the front axle after the drive: the planner's room to turn
+START_TIMEOUT = 90.0  # [s] wall: four processes starting on a loaded machine
+CLIMB_TIMEOUT = 180.0  # [s] wall: the planner's time allowance is 60 s of (wall) time
+
+
+@pytest.fixture
+def hardware_stack():
+    domain_id = next_domain_id()
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    processes = [start_node(package, executable, domain_id, parameters)
+                 for package, executable, parameters in NODES]
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    node = Node('hardware_test', context=context,
+                parameter_overrides=[Parameter('use_sim_time', value=False)])
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    try:
+        yield node, executor, processes
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+        for process in processes:
+            process.stop()
+
+
+def test_drive_by_cmd_vel_then_climb_a_5_cm_step_on_the_system_clock(hardware_stack):
+    node, executor, processes = hardware_stack
+    truth: list[Odometry] = []
+    odom: list[Odometry] = []
+    node.create_subscription(Odometry, 'ground_truth/odom', truth.append, 100)
+    node.create_subscription(Odometry, 'odom', odom.append, 100)
+    cmd_vel = node.create_publisher(TwistStamped, 'cmd_vel', 10)
+    spawn = node.create_client(SpawnObstacle, 'sim/spawn_obstacle')
+    climb = node.create_client(ClimbStep, 'climb_step')
+
+    def alive() -> bool:
+        dead = [p for p in processes if not p.running()]
+        assert not dead, process_report(dead)
+        return False
+
+    spin_until(executor, lambda: alive() or (truth and odom and spawn.service_is_ready()
+                                             and climb.service_is_ready()),
+               START_TIMEOUT, 'the stack')
+    # Stamps of the system clock, as the robot's.
+    stamp = truth[-1].header.stamp
+    assert abs(stamp.sec + stamp.nanosec * 1e-9 - time.time()) < 5.0
+
+    start = GroundTruth.from_msg(truth[-1])
+    until = time.monotonic() + 1.5  # [s] wall: the robot's time
+    while time.monotonic() < until:
+        message = TwistStamped()
+        message.header.stamp = node.get_clock().now().to_msg()
+        message.twist.linear.x = 0.3  # [m/s]
+        cmd_vel.publish(message)
+        spin_until(executor, lambda n=len(truth): alive() or len(truth) > n + 4, 30.0,
+                   'ground truth while driving')
+    stopped = len(truth)
+    spin_until(executor, lambda: alive() or len(truth) > stopped + 100, 30.0,
+               'the car to stop (cmd_vel deadman)')
+    driven = GroundTruth.from_msg(truth[-1])
+    # 0.3 m/s for 1.5 s less the ramps: at least 0.2 m, however late the answers.
+    assert driven.x - start.x > 0.2, (start, driven)
+
+    p = SwivelCarParams()
+    spawned = spawn.call_async(SpawnObstacle.Request(obstacle=StepObstacle(
+        name='step', height=STEP_HEIGHT, depth=1.5, width=1.6, distance=STEP_DISTANCE,
+        yaw=0.0, friction=1.0)))
+    spin_until(executor, spawned.done, 30.0, 'spawn_obstacle')
+    assert spawned.result().success, spawned.result().message
+    edge_x = driven.x + p.wheelbase + STEP_DISTANCE
+    answer = climb.call_async(ClimbStep.Request(
+        step_height=STEP_HEIGHT, step_distance=STEP_DISTANCE, step_yaw=0.0, step_width=1.6,
+        plan_only=False))
+    spin_until(executor, lambda: alive() or answer.done(), CLIMB_TIMEOUT, 'climb_step')
+    result = answer.result()
+    assert result.success, f'{result.error_code}: {result.message}'
+    final = GroundTruth.from_msg(truth[-1])
+    assert final.four_wheels_on_top(STEP_HEIGHT, p.r), final
+    assert final.x - p.h * abs(final.yaw) > edge_x, (final, edge_x)
