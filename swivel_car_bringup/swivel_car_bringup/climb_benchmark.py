@@ -25,7 +25,11 @@ Clopper-Pearson bound on all four wheels on top is at least 85 %
 (``swivel_car_planner/config/capability.yaml``) with the command (seed included) and the
 statistic in its header. Each height runs in its own in-process stack, ``--workers`` at once
 (processes). About 3-6 s of CPU per climb (a repositioning path adds its drive); prints,
-asserts nothing.
+asserts nothing. ``--sensor-profiles`` (default ``ideal,realistic``) runs the table once per
+sim sensor profile (``swivel_car_sim.sensor_models``: quantised encoders, the fused IMU's
+drift, lost messages, late commands; seeded, so lockstep stays deterministic) on the same
+draws, and compares all four wheels on top by height; the first profile's trials give
+``--write-capability``'s table.
 """
 
 from __future__ import annotations
@@ -348,6 +352,34 @@ def report(trials: list[Trial], car_like: dict[float, bool],
           f'the centre of mass at >= {needed:.0%} of the wheelbase')
 
 
+def compare_profiles(by_profile: dict[str, list[Trial]]) -> None:
+    """
+    Print all four wheels on top by height, one column per sensor profile (same draws).
+
+    Each column beside the first's: within one trial in eight of it, or not.
+    """
+    counts = {}
+    for profile, trials in by_profile.items():
+        by_height: dict[float, list[bool]] = defaultdict(list)
+        for trial in trials:
+            if trial.code not in _NOT_ATTEMPTED:
+                by_height[trial.height].append(trial.four)
+        counts[profile] = by_height
+    first, *others = by_profile
+    print('\nall four wheels on top, same draws: ' + ' | '.join(by_profile))
+    for height in sorted(counts[first]):
+        cells, ok = [], True
+        for profile in by_profile:
+            done = counts[profile].get(height, [])
+            cells.append(f'{sum(done):2d}/{len(done):<2d}')
+            if profile != first and done:
+                base = counts[first][height]
+                ok &= sum(done) >= sum(base) - max(1, len(base) / 8)
+        print(f'{height:.2f} m | ' + ' | '.join(cells)
+              + ('' if not others else f" | {'within' if ok else 'NOT within'} 1 in 8 of "
+                 f'{first}'))
+
+
 def design_values(path: str | Path) -> dict:
     """
     Read the robot description parameters of a design file (``config/designs/*.yaml``).
@@ -432,13 +464,18 @@ def main(argv: list[str] | None = None) -> None:
                              "heights; '' skips it")
     parser.add_argument('--write-capability', type=Path, metavar='PATH',
                         help='write the whole-car capability table the planner ships')
+    parser.add_argument('--sensor-profiles', default='ideal,realistic',
+                        help="the sim's sensors, comma-separated (ideal, realistic, a profile "
+                             'YAML): each on the same draws, the first gives the capability')
     args = parser.parse_args(argv)
     robot = _robot(args)
     try:  # every override checked before the first climb
         description = CarDescription.from_values(robot)
-        config = StackConfig.installed(
-            robot=robot, controller=_assignments(args.controller),
+        configs = {profile: StackConfig.installed(
+            robot=robot, sim={'sensor_profile': profile},
+            controller=_assignments(args.controller),
             planner={'capability_file': 'none', **_assignments(args.planner)})
+            for profile in args.sensor_profiles.split(',')}
         ranges = RequestRanges(**{item.name: getattr(args, item.name)
                                   for item in fields(RequestRanges)})
     except ValueError as error:
@@ -446,9 +483,17 @@ def main(argv: list[str] | None = None) -> None:
     seed = args.seed if args.seed is not None else random.SystemRandom().randrange(2 ** 31)
     started = time.monotonic()
     print(f'swivel car: {args.trials} attempted climbs per height, seed {seed}', flush=True)
-    trials = run_swivel(args, config, ranges, seed)
+    by_profile = {}
+    for profile, config in configs.items():
+        print(f'sensors: {profile}', flush=True)
+        by_profile[profile] = run_swivel(args, config, ranges, seed)
+    trials = next(iter(by_profile.values()))
     car_like = {} if args.skip_car_like else run_car_like(args, robot)
-    report(trials, car_like, description)
+    for profile, profile_trials in by_profile.items():
+        print(f'\nsensors: {profile}')
+        report(profile_trials, car_like, description)
+    if len(by_profile) > 1:
+        compare_profiles(by_profile)
     if args.phi_negative_heights and not args.write_capability:
         negative = design_values(PHI_NEGATIVE)
         negative_started = time.monotonic()

@@ -52,6 +52,7 @@ from swivel_car_planner.core.sync import InputSync
 from swivel_car_planner.ground_truth import GroundTruth
 from swivel_car_sim.config import PARAMETERS as SIM_PARAMETERS, SimNodeConfig
 from swivel_car_sim.physics import SwivelCarSim
+from swivel_car_sim.sensor_models import DelayedCommands, SensorSuite
 from swivel_car_sim.world import StepSpec
 import yaml
 
@@ -379,6 +380,10 @@ class InProcessStack:
         self._steps_per_period = c.sim.steps_per_period
         self._time_step_ns = round(c.sim.physics.time_step * 1e9)  # as sim_node stamps
         self.sim = SwivelCarSim(c.sim.physics, c.sim.initial_pose)
+        # The sim's sensor_profile: None for ideal (the state as it is, commands at once).
+        self._sensors = (None if c.sim.sensors.ideal
+                         else SensorSuite(c.sim.sensors, c.sim.sensor_seed, self.sim.state()))
+        self._commands = DelayedCommands(c.sim.physics.time_step)
         self._periods = 0  # control periods published, as sim_node counts them for imu
         self.profile = profile
         self.timings: dict[str, list[float]] = {}  # name -> [total wall s, count]
@@ -445,6 +450,9 @@ class InProcessStack:
 
         """
         self.sim.reset(x, y, yaw, remove_obstacles=True)
+        self._commands.clear()
+        if self._sensors is not None:
+            self._sensors.reset(self.sim.state())
         self._start_nodes()
 
     def reset_odometry(self) -> None:
@@ -510,6 +518,19 @@ class InProcessStack:
         names = state.joint_names
         positions, velocities = state.positions.tolist(), state.velocities.tolist()
         orientation = state.orientation.tolist()
+        if self._sensors is not None:
+            sample = self._sensors.sample(state)
+            if sample.lost:  # no node hears it: the sim goes on with the command it has
+                last = self._rows[-1][-2:] if self._rows else (0.0, 0.0)  # [N m], [rad/s]
+                self._rows.append((t, *state.position.tolist(), *orientation, *positions,
+                                   *last))
+                self._commands.step(self.sim, self._steps_per_period, self.sim.set_command)
+                self._periods += 1
+                return
+            positions, velocities = sample.positions.tolist(), sample.velocities.tolist()
+            measured = sample.orientation.tolist()
+        else:
+            measured = orientation
 
         # controller_node: cmd_vel (renewed every period while driving), then the answer.
         if self._cmd_vel is not None:
@@ -532,7 +553,7 @@ class InProcessStack:
         # planner_node: its three inputs of t; a tick steps the running climb.
         ticks = []
         if self._periods % self.config.sim.imu_every == 0:
-            ticks += self._sync.add(inputs.IMU, t, inputs.imu_values(orientation))
+            ticks += self._sync.add(inputs.IMU, t, inputs.imu_values(measured))
         if odom_due:
             o = self.odometry.odometry
             ticks += self._sync.add(inputs.ODOM, t, inputs.odom_values(
@@ -549,11 +570,18 @@ class InProcessStack:
         for tick in ticks:
             self._on_tick(tick)
 
-        self._rows.append((t, *state.position.tolist(), *orientation, *positions, torque,
-                           drive))
+        self._rows.append((t, *state.position.tolist(), *orientation,
+                           *state.positions.tolist(), torque, drive))
         # sim_node: the actuator command of t, one control period of physics.
-        self.sim.set_command(torque, drive)
-        self._timed('sim', self.sim.step, self._steps_per_period)
+        if self._sensors is None:
+            self.sim.set_command(torque, drive)
+            self._timed('sim', self.sim.step, self._steps_per_period)
+        else:
+            if not self._sensors.transport.lost():
+                self._commands.push(self.sim.steps, self._sensors.transport.command_delay(),
+                                    (torque, drive))
+            self._timed('sim', self._commands.step, self.sim, self._steps_per_period,
+                        self.sim.set_command)
         self._periods += 1
 
     def _on_tick(self, tick) -> None:

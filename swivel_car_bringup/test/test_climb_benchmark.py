@@ -41,7 +41,8 @@ def test_each_shipped_design_has_a_table_measured_on_it():
     ('--planner=rear_speed=-1', 'rear_speed must be >= 0'),
     ('--phi-negative-heights=0.05,-0.05', 'must be a finite height > 0 m, got -0.05'),
     ('--max-height=inf', 'must be a finite height > 0 m, got inf'),
-    ('--step=0', 'must be a finite height > 0 m, got 0')])
+    ('--step=0', 'must be a finite height > 0 m, got 0'),
+    ('--sensor-profiles=ideal,noisy', 'sensor_profile must be one of ideal, realistic')])
 def test_a_bad_override_is_a_usage_error_before_any_climb(option, message, capsys):
     with pytest.raises(SystemExit) as exit_:
         main(['--heights', '0.02', '--trials', '1', '--skip-car-like', option])
