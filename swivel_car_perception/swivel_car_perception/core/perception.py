@@ -15,12 +15,13 @@ class StepPerception:
 
     Parameters
     ----------
-    detector : StepDetector
+    detector : StepDetector or None
+        None until the camera's intrinsics are known; set it before ``frame``.
     tracker : StepTracker
 
     """
 
-    def __init__(self, detector: StepDetector, tracker: StepTracker) -> None:
+    def __init__(self, detector: StepDetector | None, tracker: StepTracker) -> None:
         self.detector = detector
         self.tracker = tracker
         self.poses = PoseHistory()
