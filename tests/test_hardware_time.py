@@ -12,8 +12,9 @@ Bounds and a loaded machine: nothing here waits for another process in step, so 
 does not depend on the load except through the controller's answers arriving late. What is
 asserted is physical (the car moved forward, all four wheels on top, level), never a time.
 The timeouts are guards against a hang, sized for a machine shared by several test workers:
-the sim skips ahead when it is more than 0.1 s behind the system clock, so a climb of about
-15 s of sim time takes about 15 s of wall time whatever the load.
+the sim catches up a backlog in physics (publishing only its last state, as a lost message)
+and skips ahead only when more than 1 s behind the system clock, so a climb of about 15 s
+of sim time takes about 15 s of wall time whatever the load.
 """
 
 from __future__ import annotations

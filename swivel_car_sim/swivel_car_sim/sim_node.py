@@ -161,7 +161,11 @@ class SimNode(Node):
             return
         sim_ns = self.sim.steps * self._time_step_ns  # [ns]
         skipped = self._wall.skipped_ns
-        for _ in range(self._wall.due(sim_ns, time.time_ns())):
+        quiet, published = self._wall.due(sim_ns, time.time_ns())
+        if quiet:
+            self._step_physics(quiet * self.config.steps_per_period)
+            self._periods += quiet
+        for _ in range(published):
             self._advance()
         if self._wall.skipped_ns > skipped:
             self.get_logger().warn(

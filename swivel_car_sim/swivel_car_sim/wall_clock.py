@@ -5,14 +5,18 @@ ROS-free. A driver board samples at a fixed cadence and stamps each sample with 
 clock. The sim does the same: a state's stamp is its sim time plus an offset to the system
 clock, fixed while the sim runs, so that stamps advance exactly as the physics does (the
 odometry integrates rates over stamp differences). The pace follows the system clock: each
-timer call advances the periods that are due, so a timer that fires late catches up; a sim
-more than ``MAX_LAG`` behind (a stalled machine) gives that backlog up instead of racing
-through it, and its stamps jump forward by it, as a board's would after a stall.
+timer call advances the periods that are due, so a timer that fires late catches up. A
+backlog over ``QUIET_LAG_NS`` (a busy machine) is caught up in physics without publishing
+its states but the last, as if the link had lost them: the robot goes on moving meanwhile,
+as a real one does while its computer stalls, and the next state's rates span the gap. Only
+a backlog over ``MAX_LAG_NS`` (a stalled machine) is given up: the stamps jump forward by it
+while the physics did not move.
 """
 
 from __future__ import annotations
 
-MAX_LAG_NS = 100_000_000  # [ns] backlog the sim catches up; beyond it, it skips ahead
+QUIET_LAG_NS = 50_000_000  # [ns] backlog caught up publishing only its last state
+MAX_LAG_NS = 1_000_000_000  # [ns] backlog the sim catches up; beyond it, it skips ahead
 
 
 class WallPacer:
@@ -43,11 +47,14 @@ class WallPacer:
         """Start the pace afresh at ``now_ns`` (resumed from a pause, or stepped meanwhile)."""
         self.offset_ns = max(self.offset_ns, now_ns - sim_ns)
 
-    def due(self, sim_ns: int, now_ns: int) -> int:
+    def due(self, sim_ns: int, now_ns: int) -> tuple[int, int]:
         """
-        Return how many control periods to advance now, at ``now_ns`` [ns] of the system clock.
+        Return the control periods to advance now, at ``now_ns`` [ns] of the system clock.
 
-        A backlog over ``MAX_LAG_NS`` is given up (``skipped_ns``): the stamps jump ahead.
+        (quiet, published): the first ``quiet`` periods are stepped without publishing
+        their states (a backlog over ``QUIET_LAG_NS``), then ``published`` periods are
+        advanced as usual. A backlog over ``MAX_LAG_NS`` is given up (``skipped_ns``): the
+        stamps jump ahead.
         """
         behind = now_ns - self.stamp_ns(sim_ns)  # [ns]
         if behind > MAX_LAG_NS:
@@ -55,4 +62,7 @@ class WallPacer:
             self.offset_ns += skip
             self.skipped_ns += skip
             behind -= skip
-        return max(0, behind // self.control_period_ns)
+        periods = max(0, behind // self.control_period_ns)
+        if behind > QUIET_LAG_NS:
+            return periods - 1, 1
+        return 0, periods

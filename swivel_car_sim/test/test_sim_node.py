@@ -447,3 +447,31 @@ def test_wall_clock_refuses_run_and_a_stamp_older_than_the_watchdog(harness_fact
     h.command(Time(sec=old // 10**9, nanosec=old % 10**9), drive_speed=5.0)
     spin_until(h.executor, lambda: h.sim.sim.time > 0.05, TIMEOUT, 'running')
     assert h.sim.sim.state().velocities[1] == pytest.approx(0.0, abs=0.05)
+
+
+def test_wall_clock_after_a_stall_the_rates_span_the_gap_the_robot_moved_through(
+        harness_factory):
+    """
+    A stalled executor (a loaded machine): the sim catches the physics up, states unpublished.
+
+    The robot went on moving meanwhile, as a real one does, so the first state after the gap
+    carries the wheel rate over it: rate times stamp gap is the distance the wheel turned,
+    which the odometry integrates. (Skipping the backlog instead had the stamps jump 0.3 s
+    while the wheel turned for 0.01 s.)
+    """
+    h = harness_factory(clock_source='wall', sensor_profile='realistic', watchdog_timeout=0.0)
+    spin_until(h.executor, lambda: h.joint_states, TIMEOUT, 'first joint_states')
+    h.command(h.joint_states[-1].header.stamp, drive_speed=5.0)
+    spin_until(h.executor, lambda: h.joint_states[-1].velocity[1] > 4.0, TIMEOUT, 'rolling')
+    before = h.joint_states[-1]
+    count = len(h.joint_states)
+    time.sleep(0.3)  # [s] the stall: nothing spins
+    spin_until(h.executor, lambda: len(h.joint_states) > count, TIMEOUT, 'a state after it')
+    after = h.joint_states[count]
+    gap = (_ns(after.header.stamp) - _ns(before.header.stamp)) * 1e-9  # [s]
+    assert gap > 0.2
+    turned = after.position[1] - before.position[1]  # [rad]
+    assert after.velocity[1] * gap == pytest.approx(turned, abs=1e-9)
+    # The wheel kept moving, at least at its rate before (it was still speeding up towards
+    # the command); 0.9: one tick in a period is 0.33 rad/s, 8 % of that rate.
+    assert turned > 0.9 * before.velocity[1] * gap
