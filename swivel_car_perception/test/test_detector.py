@@ -73,3 +73,25 @@ def test_no_return_anywhere_and_the_sky_are_no_step():
 def test_an_image_of_another_size_is_refused():
     with pytest.raises(ValueError, match='106x60.*212x120'):
         DETECTOR.detect(np.zeros((60, 106)))
+
+
+def _tilted(roll, pitch):
+    """Return the mounting of a car rolled and pitched about base_link's origin [rad]."""
+    cr, sr, cp, sp = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
+    rotation = (np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
+                @ np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]]))
+    return Mount(rotation @ MOUNT.rotation, rotation @ MOUNT.position, MOUNT.ground_height,
+                 MOUNT.front_axle, MOUNT.self_reach)
+
+
+@pytest.mark.parametrize('roll, pitch', [(0.06, 0.0), (0.0, -0.05), (0.06, -0.05)])
+def test_a_tilted_car_still_measures_a_near_step(roll, pitch):
+    # The car turning onto its approach rolls and pitches by a few degrees (the swivel lifts
+    # it): a near step's top face then lay where the level ground should be, and the ground
+    # fitted to both gave it 1.9 cm of its 4 cm, or no ground at all.
+    step = (0.04, 0.5, 0.39, 2.5, 0.0, 3.0)
+    d = DETECTOR.detect(depth_image(step, mount=_tilted(roll, pitch), noise_seed=1))
+    assert d.found, d.reason
+    assert d.height == pytest.approx(0.04, abs=0.005)
+    assert d.distance == pytest.approx(0.5, abs=0.015) and d.yaw == pytest.approx(0.39, abs=0.02)
+    assert d.ground_roll == pytest.approx(-roll, abs=0.005)

@@ -7,8 +7,10 @@ step_detector_node as real processes; the step is spawned in the sim only, the c
 """
 
 from sim_session import CLIMB_WALL_LIMIT, LOCKSTEP_TIMEOUT, SimSession
+from swivel_car_msgs.action import ClimbStep
 from swivel_car_msgs.msg import DetectedStep
-from swivel_car_msgs.srv import ClimbStep
+from swivel_car_planner.core import Phase
+from swivel_car_planner.core.detected import MIN_FOLLOW_DISTANCE
 from swivel_car_stack import start_node
 
 HEIGHT = 0.04  # [m] within the whole car's measured limit (README)
@@ -37,18 +39,26 @@ def test_a_detected_step_is_climbed_with_all_four_wheels_on_top():
         session.spin_until(lambda: detections and detections[-1].found, 60.0 + LOCKSTEP_TIMEOUT,
                            'a detection of the step')
         seen = detections[-1]
-        # The planner takes the detections on its own executor: under load the request can
-        # come before it has taken one (refused, nothing moved); asked again then.
+        # The action, for its feedback. The planner takes the detections on its own executor:
+        # under load the goal can come before it has taken one (refused, nothing moved);
+        # asked again then.
+        feedback = []
         for _ in range(20):
-            response = session.call(session.climb_client,
-                                    ClimbStep.Request(use_detected_step=True),
-                                    timeout=CLIMB_WALL_LIMIT)
+            response = _climb_detected(session, feedback)
             if not response.message.startswith('no detected_step heard'):
                 break
             session.settle(0.2)
         assert response.success, response.message
         session.settle(0.5)
         assert session.four_wheels_on_top(HEIGHT), session.truth
+        # The refined estimate is in the feedback while the car approaches: the edge nearer
+        # as the car drives towards it. Bounds where the approach follows detections (from
+        # MIN_FOLLOW_DISTANCE on): nearer, the front wheels hide parts of the step.
+        approach = [f.detected_step for f in feedback
+                    if f.phase == Phase.APPROACH and f.detected_step.found
+                    and f.detected_step.step.distance >= MIN_FOLLOW_DISTANCE]
+        assert approach and all(abs(d.step.height - HEIGHT) < 0.005 for d in approach)
+        assert min(d.step.distance for d in approach) < approach[0].step.distance - 0.1
     finally:
         crashed = session.close()
     assert not crashed, crashed
@@ -56,3 +66,14 @@ def test_a_detected_step_is_climbed_with_all_four_wheels_on_top():
     # here the bounds are the issue's targets).
     assert abs(seen.step.height - HEIGHT) < 0.005 and abs(seen.step.yaw - YAW) < 0.02
     assert abs(seen.step.distance - DISTANCE) < 0.015 + 0.05  # the car may have crept
+
+
+def _climb_detected(session: SimSession, feedback: list):
+    """Send the climb_step goal {use_detected_step: true}; return its result at the end."""
+    sent = session.climb_action.send_goal_async(
+        ClimbStep.Goal(use_detected_step=True),
+        feedback_callback=lambda message: feedback.append(message.feedback))
+    session.spin_until(sent.done, 30.0, 'the goal accepted')
+    result = sent.result().get_result_async()
+    session.spin_until(result.done, CLIMB_WALL_LIMIT, 'the climb to end')
+    return result.result().result

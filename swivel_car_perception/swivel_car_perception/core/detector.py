@@ -36,6 +36,8 @@ ENDS_PROBE = 0.04  # [m] how far past an end of the edge the camera must see gro
 # turns them (a wheel of radius r, swung forward by up to about 0.1 m): the camera sees
 # them, and nothing nearer counts as a step.
 SELF_REACH_MARGIN = 0.1  # [m]
+GROUND_HYPOTHESES = 80  # planes tried for the ground (three points each)
+MAX_TILT = 0.2  # [rad] steepest ground plane: the car pitched or rolled on flat ground
 
 
 @dataclass(frozen=True)
@@ -115,7 +117,7 @@ class DetectorConfig:
     max_lateral: float = 2.0  # [m]
     min_riser_points: int = 30
     min_ground_points: int = 300
-    ground_band: float = 0.025  # [m]
+    ground_band: float = 0.08  # [m]
     sigma_per_metre_squared: float = 0.08 / (424.0 * 0.05)  # [1/m]
 
 
@@ -280,23 +282,50 @@ class StepDetector:
         return Detection(**{**detection.__dict__, 'ground_pitch': pitch, 'ground_roll': roll})
 
     def _ground(self, points: np.ndarray, z: np.ndarray):
-        """Fit the ground plane: (upward unit normal, offset so that n.p + d = height, std)."""
+        """
+        Fit the ground plane: (upward unit normal, offset so that n.p + d = height, std).
+
+        Planes through three points near where the ground should be (within ``ground_band``
+        of it: a car tilted by up to about 3 degrees), none steeper than ``MAX_TILT``; of
+        those with at least half the best one's support, the lowest (a near step's top face
+        can be as large as the ground in view, never below it). Then least squares on every
+        point near that plane, weighted by the depth variance, refitted on its inliers.
+        """
         cfg, mount = self.config, self.mount
         near = np.abs(points[:, 2] + mount.ground_height) < cfg.ground_band
         if near.sum() < cfg.min_ground_points:
             return None
         candidates = points[near]
-        weights = 1.0 / (cfg.sigma_per_metre_squared * z[near] ** 2 + 1e-3) ** 2
-        inliers = np.ones(len(candidates), dtype=bool)
+        rng = np.random.default_rng(0)  # the same hypotheses for the same image
+        triples = candidates[rng.integers(0, len(candidates), (GROUND_HYPOTHESES, 3))]
+        normals = np.cross(triples[:, 1] - triples[:, 0], triples[:, 2] - triples[:, 0])
+        length = np.linalg.norm(normals, axis=1)
+        usable = length > 1e-9
+        normals = normals[usable] / length[usable, None] * np.sign(normals[usable, 2:3])
+        offsets = -np.einsum('ij,ij->i', normals, triples[usable, 0])
+        upright = normals[:, 2] > math.cos(MAX_TILT)
+        normals, offsets = normals[upright], offsets[upright]
+        if len(normals) == 0:
+            return None
+        support = (np.abs(candidates @ normals.T + offsets) < 0.01).sum(axis=0)
+        good = support >= support.max() / 2.0
+        # Height of each plane below base_link's origin, where the camera looks: the lowest.
+        probe = np.array([mount.front_axle + 0.5, 0.0])
+        level = -(normals[:, 0] * probe[0] + normals[:, 1] * probe[1] + offsets) / normals[:, 2]
+        best = int(np.argmin(np.where(good, level, np.inf)))
+        fit = normals[best], float(offsets[best])
+        weights = 1.0 / (cfg.sigma_per_metre_squared * z ** 2 + 1e-3) ** 2
+        threshold = 0.01
         for _ in range(3):
-            fit = _plane(candidates[inliers], weights[inliers])
-            residual = candidates @ fit[0] + fit[1]
-            spread = 1.4826 * float(np.median(np.abs(residual[inliers])))
-            inliers = np.abs(residual) < max(3.0 * spread, 0.004)
+            residual = points @ fit[0] + fit[1]
+            inliers = np.abs(residual) < threshold
             if inliers.sum() < cfg.min_ground_points:
                 return None
-        normal, offset = _plane(candidates[inliers], weights[inliers])
-        residual = candidates[inliers] @ normal + offset
+            fit = _plane(points[inliers], weights[inliers])
+            residual = points[inliers] @ fit[0] + fit[1]
+            threshold = max(3.0 * 1.4826 * float(np.median(np.abs(residual))), 0.004)
+        normal, offset = fit
+        residual = points[inliers] @ normal + offset
         std = float(np.std(residual)) / math.sqrt(inliers.sum())
         return normal, offset, std
 
