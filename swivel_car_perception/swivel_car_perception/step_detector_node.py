@@ -37,7 +37,7 @@ class StepDetectorConfig:
 
     base_frame_id: str = 'base_link'
     min_height: float = 0.012  # [m]
-    max_distance: float = 1.6  # [m]
+    max_distance: float = 2.2  # [m]
     max_lateral: float = 2.0  # [m]
     odom_drift: float = 0.02  # [1]
     gate: float = 5.0  # [1]

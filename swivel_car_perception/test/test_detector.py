@@ -48,7 +48,7 @@ def test_a_step_wider_than_the_view_has_no_ends_and_a_lower_bound_width():
 
 
 def test_a_step_beyond_max_distance_or_too_low_is_not_reported():
-    far = DETECTOR.detect(depth_image((0.1, 2.2, 0.0, 2.0, 0.0, 1.0)))
+    far = DETECTOR.detect(depth_image((0.1, 2.8, 0.0, 2.0, 0.0, 1.0)))
     assert not far.found and 'outside' in far.reason
     low = DETECTOR.detect(depth_image((0.01, 0.8, 0.0, 2.0, 0.0, 1.0)))
     assert not low.found

@@ -113,7 +113,7 @@ class DetectorConfig:
     """
 
     min_height: float = 0.012  # [m]
-    max_distance: float = 1.6  # [m]
+    max_distance: float = 2.2  # [m]
     max_lateral: float = 2.0  # [m]
     min_riser_points: int = 30
     min_ground_points: int = 300

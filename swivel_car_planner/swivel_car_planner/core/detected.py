@@ -16,10 +16,10 @@ import math
 from swivel_car_perception.core.detector import Detection
 from swivel_car_perception.core.fusion import moved, Pose2D as OdomPose
 from swivel_car_perception.core.poses import PoseHistory
-from swivel_car_planner.core.codes import Phase
 from swivel_car_planner.core.geometry import Pose2D, StepEdge, wrap_angle
 from swivel_car_planner.core.request import ClimbRequest
 from swivel_car_planner.core.state_machine import ClimbStateMachine, Observation
+from swivel_car_planner.core.steps import Step
 
 # An end of the edge the camera did not see lies somewhere beyond what it saw: the request's
 # face reaches this far on that side: beyond any crossing the approach can reach.
@@ -143,7 +143,9 @@ class DetectedSteps:
 
         The climb's heading is the IMU's (odometry's drifts while the swivel turns at a
         standstill), so the detections are placed with the climb's own poses. In the
-        approach, a new detection beyond its uncertainty becomes the climb's edge. Returns
+        approach proper (the drive to the lift point; not while backing up or repositioning,
+        whose paths were planned on the first edge), a new detection beyond its uncertainty
+        becomes the climb's edge. Returns
         how far (along the old normal [m]) and by how much (turn [rad]) the edge moved, or
         None.
         """
@@ -151,7 +153,7 @@ class DetectedSteps:
         if climb is None:
             return None
         self.pose(stamp, obs.x, obs.y, climb.heading(obs))
-        if not correct or machine.phase != Phase.APPROACH:
+        if not correct or machine.step != Step.APPROACH:
             return None
         edge = self.correction(climb.edge, stamp)
         if edge is None:
