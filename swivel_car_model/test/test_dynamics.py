@@ -133,8 +133,10 @@ def test_planar_run_keeps_the_constraints(thesis_run):
 
 def test_planar_run_is_rate_independent(thesis_run):
     fast = d.simulate_planar_swivel(P, rate=1.0, samples=2)
+    # Each run's end pose against an rtol 1e-12 run: 1.5e-7 (thesis rate) and 4.8e-8 m and
+    # rad apart, so up to 2e-7 between them; 1e-6 gives fivefold margin for another CPU.
     assert (fast.x[-1], fast.y[-1], fast.yaw[-1]) == pytest.approx(
-        (thesis_run.x[-1], thesis_run.y[-1], thesis_run.yaw[-1]), abs=1e-7)
+        (thesis_run.x[-1], thesis_run.y[-1], thesis_run.yaw[-1]), abs=1e-6)
 
 
 def test_unactuated_dae_conserves_kinetic_energy():
@@ -195,8 +197,15 @@ def test_planar_swivel_bad_input(kwargs):
         d.simulate_planar_swivel(P, **kwargs)
 
 
+# The spline's error, measured against rtol 1e-12 runs at 44 angles over 0-1.5707 rad: at
+# most 2.9e-7 m and rad (its rtol 1e-8 run plus interpolation); the direct rtol 1e-9 run
+# differs from that reference by at most 4.8e-8. 1e-6 leaves a threefold margin for another
+# CPU's rounding, which moves the adaptive steps.
+DRIFT_SPLINE_ERROR = 1e-6  # [m], [rad]
+
+
 @pytest.mark.parametrize('theta2', [0.013, 0.7, -1.2, 1.57])
 def test_drift_from_zero_spline_matches_direct_integration(theta2):
     run = d.simulate_planar_swivel(P, 0.0, theta2, rate=1.0, samples=2)
     assert d.swivel_pose_drift(P, 0.0, theta2) == pytest.approx(
-        (run.x[-1], run.y[-1], run.yaw[-1]), abs=1e-7)
+        (run.x[-1], run.y[-1], run.yaw[-1]), abs=DRIFT_SPLINE_ERROR)
