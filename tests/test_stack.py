@@ -113,6 +113,7 @@ class Stack:
         self.releasing = False
         self.silent = False
         self.released_at = 0.0  # [s] the state the last release answered
+        self.release_stamp = Time()  # the last release's stamp (zero: unstamped)
         self.unanswered: deque[SwivelControllerState] = deque(maxlen=QUEUE)
         self.odom_time: float | None = None  # [s] of the running odometry's last odom
         self.user.create_subscription(Odometry, 'ground_truth/odom', self._on_truth, QUEUE)
@@ -191,9 +192,11 @@ class Stack:
         msg = TwistStamped()
         msg.twist.linear.x, msg.twist.angular.z = self.twist
         if self.releasing:
-            # Unstamped: the controller takes it as heard at this state and waits no more.
+            # Unstamped, or stamped in another clock than the states': the controller takes it
+            # as heard at its next step and waits no more.
             self.releasing, self.silent = False, True
             self.released_at = stamp_to_seconds(state.header.stamp)
+            msg.header.stamp = self.release_stamp
         else:
             msg.header.stamp = state.header.stamp
         self.cmd_vel.publish(msg)
@@ -401,13 +404,14 @@ class Stack:
         t = stamp_to_seconds(state.header.stamp)
         return t - 1.5 * CONTROL_PERIOD <= moment_seconds(state.cmd_vel_stamp) < t
 
-    def release(self) -> float:
+    def release(self, stamp: Time | None = None) -> float:
         """
         Leave the chain: answer the next state with the cmd_vel, unstamped, then nothing.
 
-        Returns the time of that state [s]: the cmd_vel deadman counts from it.
+        ``stamp``: a stamp from another clock instead (a wall clock's), which the states'
+        ``cmd_vel_stamp`` then report. Returns the time of that state [s].
         """
-        self.releasing = True
+        self.releasing, self.release_stamp = True, Time() if stamp is None else stamp
         self.spin_until(lambda: self.silent, 60.0, 'the release')
         return self.released_at
 
@@ -765,10 +769,20 @@ def test_a_use_sim_time_flip_mid_drive_does_not_stretch_the_cmd_vel_deadman(stac
         stack.wait_sim_time(0.5, 'the drive')
         assert stack.speed() > 0.2, 'the flipped controller no longer obeys cmd_vel'
         # ...and stops the car within its deadman once it no longer comes: the last cmd_vel
-        # is unstamped, which the flipped controller stamps with the wall time on receipt.
-        last = stack.release()
+        # is stamped with the wall time, as a teleop on the wall clock does. The deadman
+        # counts from the controller's first step after its receipt (a stamp ahead of the step
+        # counts as given then), which the states report: when that was depends on who got
+        # the CPU first (the controller waits 1.5 s of wall time for an answer, then goes on).
+        wall_ns = time.time_ns()  # [ns]
+        wall = Time(sec=wall_ns // 10**9, nanosec=wall_ns % 10**9)
+        stack.release(wall)
+
+        def heard() -> float:
+            return next(stamp_to_seconds(s.header.stamp) for s in stack.controller_states
+                        if s.cmd_vel_stamp == wall)
+
         stack.wait_stopped(DEADMAN + BRAKING + 0.1, 'the car to stop after the flip',
-                           since=lambda: last)
+                           since=heard)
         stack.wait_sim_time(1.0, 'the car to stand')
         assert stack.speed() < 0.02
         use_sim_time(True)
@@ -787,13 +801,20 @@ def test_a_clock_far_ahead_stretches_no_deadman_and_every_node_survives_it(stack
     stack.pause_sim(True)
     stack.clock.publish(Clock(clock=time_msg(2.0**31 - 1)))
     stack.wait_wall(0.3, 'the nodes to hear the /clock')
+    count = len(stack.controller_states)
     stack.swivel_command.publish(SwivelCommand(angle=0.0, drive_speed=3.0, hold=True))
     stack.wait_wall(0.3, 'the controller to hear the swivel_command')
     stack.pause_sim(False)
-    start = stack.sim_time()
+
+    def heard() -> float:
+        # The deadman counts from the receipt, taken as the step before the first one that
+        # obeys it (the controller's own report): a controller that got the CPU only after
+        # the resume heard it later than the 0.3 s of wall time above.
+        first = next(s for s in stack.controller_states[count:] if s.source == 'swivel_command')
+        return stamp_to_seconds(first.header.stamp) - CONTROL_PERIOD
+
     stack.spin_until(lambda: stack.speed() > 0.1, 60.0, 'the held command to drive')
-    stack.wait_stopped(DEADMAN + BRAKING + 0.1, 'the deadman to stop the car',
-                       since=lambda: start)
+    stack.wait_stopped(DEADMAN + BRAKING + 0.1, 'the deadman to stop the car', since=heard)
 
     # Every node went on (spin_until checks their processes): the odometry follows the
     # car, the planner takes requests, cmd_vel drives.
