@@ -323,8 +323,8 @@ def swivel_pose_drift(p: SwivelCarParams, theta2_from: float,
     Rate independent (see the module docstring); the pose is taken when the swivel reaches
     ``theta2_to`` (after that the car coasts unless its wheels are braked). A move through
     zero is two moves, each from rest. Moves from zero come from one cached run over the whole
-    range (a spline; within 3e-7 m and rad of an rtol 1e-12 run); others are integrated once and cached per arguments
-    (rounded to 1e-6 rad).
+    range (a spline; within 3e-7 m and rad of an rtol 1e-12 run); others are integrated once
+    and cached per arguments (rounded to 1e-6 rad).
 
     Returns
     -------
