@@ -19,7 +19,7 @@ IN_WS := scripts/in_ws
 PYTEST_ARGS ?=
 PYTEST_WORKERS ?= $(shell echo $$(( $$(nproc) + 1 )))
 
-.PHONY: setup build test demo figures bench soak clean
+.PHONY: setup build test test-repeat demo figures bench soak clean
 
 setup: $(STAMP)
 
@@ -86,6 +86,14 @@ test: build $(FOXGLOVE_NPM)
 	@echo '== running every test'
 	$(IN_WS) python -m pytest -n $(PYTEST_WORKERS) --dist loadfile --no-loadscope-reorder \
 	    $(PYTEST_ARGS)
+
+# The flake hunt: the whole suite RUNS times (HOG=1: one core kept busy meanwhile); prints each
+# test that failed and how often.
+RUNS ?= 5
+HOG ?= 0
+test-repeat: build
+	$(IN_WS) python scripts/test_repeat.py --runs $(RUNS) --workers $(PYTEST_WORKERS) \
+	    $(if $(filter 1,$(HOG)),--hog) $(PYTEST_ARGS)
 
 demo: build
 	@echo '== running the demo: the simulated car drives to a step and climbs it'
