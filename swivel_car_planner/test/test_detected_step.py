@@ -68,6 +68,8 @@ def test_the_approach_follows_a_detection_beyond_its_uncertainty_once():
     steps = DetectedSteps(FRONT_AXLE, max_age=0.5)
     planned = StepEdge.from_request(Pose2D(0.0, 0.0, 0.0), FRONT_AXLE, 1.0, 0.1)
     steps.pose(1.0, 0.0, 0.0, 0.0)
+    steps.heard(1.0, _step(distance=1.0))
+    steps.request(ClimbRequest(0.0, 0.0, 0.0), now=1.0)  # the climb's step: 5 cm high
     steps.heard(1.0, _step(distance=1.003))  # 3 mm: within 2 sigma of 2 mm
     assert steps.correction(planned, 1.1) is None
     steps.heard(1.1, _step(distance=1.03))  # 3 cm further: beyond
@@ -81,6 +83,11 @@ def test_the_approach_follows_a_detection_beyond_its_uncertainty_once():
     steps.heard(1.2, _step(distance=0.3))  # 0.7 m off, but where the front wheels hide it
     steps.pose(1.2, 0.0, 0.0, 0.0)
     assert steps.correction(moved, 1.2) is None
+    for stamp, misread in ((1.3, _step(distance=1.2)), (1.4, _step(yaw=0.3)),
+                           (1.5, replace(_step(distance=1.05), height=0.02))):
+        steps.pose(stamp, 0.0, 0.0, 0.0)
+        steps.heard(stamp, misread)  # 17 cm, 0.2 rad off, or 3 cm lower: a misreading
+        assert steps.correction(moved, stamp) is None
 
 
 def test_the_planner_node_refuses_use_detected_step_without_a_detector():

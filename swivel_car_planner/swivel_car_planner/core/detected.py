@@ -28,6 +28,13 @@ UNSEEN_REACH = 2.0  # [m] (the offset stays within the request's 3 m)
 # turns onto its approach) hide parts of the riser: the edge's yaw jumped by 0.05-0.07 rad
 # between frames there (detected climb benchmark), so such detections correct nothing.
 MIN_FOLLOW_DISTANCE = 0.35  # [m]
+# A detection further than this from the edge the climb works to, or of another height, is
+# a misreading (odometry drifts by centimetres over an approach), not a better estimate: in
+# the detected climb benchmark, 2 cm steps read so during the turn onto the approach moved
+# the edge by 0.2-1.1 m and 0.1-0.7 rad and sent the car to its lift point 0.5 rad off.
+MAX_SHIFT = 0.1  # [m]
+MAX_TURN = 0.1  # [rad]
+MAX_HEIGHT_CHANGE = 0.01  # [m]
 # Smallest edge move that counts as one, whatever the detection's uncertainty: the odometry's
 # own jitter between two frames.
 MIN_SHIFT = 0.003  # [m]
@@ -53,6 +60,7 @@ class DetectedSteps:
         self.poses = PoseHistory(span=max(2.0, 2.0 * max_age))
         self._latest: tuple[float, Detection] | None = None  # (stamp [s], detection)
         self._used = -math.inf  # [s] stamp of the last detection that corrected an edge
+        self._height = math.nan  # [m] of the step the last request took
 
     def pose(self, stamp: float, x: float, y: float, yaw: float) -> None:
         """Note where the car is at ``stamp`` [s]: odometry's pose, or a climb's."""
@@ -101,6 +109,7 @@ class DetectedSteps:
         right = d.offset - d.width / 2.0 - (0.0 if d.right_end_seen else UNSEEN_REACH)
         if not (d.left_end_seen or d.right_end_seen):
             left = right = 0.0
+        self._height = d.height
         return replace(request, step_height=d.height, step_distance=max(0.0, d.distance),
                        step_yaw=d.yaw, step_width=left - right,
                        step_offset=(left + right) / 2.0), ''
@@ -109,8 +118,9 @@ class DetectedSteps:
         """
         Return the edge a new fresh detection puts elsewhere than ``edge``, or None.
 
-        Elsewhere: more than twice its one-sigma distance or yaw uncertainty away; only a
-        detection at least ``MIN_FOLLOW_DISTANCE`` ahead of the front axle counts. The poses
+        Elsewhere: more than twice its one-sigma distance or yaw uncertainty away, but within
+        ``MAX_SHIFT`` and ``MAX_TURN`` and of the requested step's height (else a misreading);
+        only a detection at least ``MIN_FOLLOW_DISTANCE`` ahead of the front axle counts. The poses
         must be in ``edge``'s frame. The returned edge keeps ``edge``'s point's place along
         the edge (the plan's crossing is measured from it). A detection corrects at most once.
         """
@@ -118,7 +128,8 @@ class DetectedSteps:
             return None
         stamp, d = self._latest
         if (not d.found or now - stamp > self.max_age or stamp <= self._used
-                or d.distance < MIN_FOLLOW_DISTANCE):
+                or d.distance < MIN_FOLLOW_DISTANCE
+                or not abs(d.height - self._height) <= MAX_HEIGHT_CHANGE):
             return None
         then = self.poses.at(round(stamp * 1e9))
         if then is None:
@@ -130,6 +141,8 @@ class DetectedSteps:
         turn = wrap_angle(seen.normal_yaw - edge.normal_yaw)  # [rad]
         if abs(shift) <= max(2.0 * d.distance_std, MIN_SHIFT) \
                 and abs(turn) <= max(2.0 * d.yaw_std, MIN_TURN):
+            return None
+        if abs(shift) > MAX_SHIFT or abs(turn) > MAX_TURN:
             return None
         # The old point dropped onto the new line.
         gap = seen.signed_distance(edge.px, edge.py)
