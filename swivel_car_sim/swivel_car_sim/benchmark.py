@@ -43,7 +43,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
 from std_srvs.srv import SetBool
 
-from swivel_car_sim.physics import SwivelCarSim
+from swivel_car_sim.physics import STOP_SLACK, SwivelCarSim
 from swivel_car_sim.sim_node import SimNode
 
 TIME_STEP = 0.002  # [s]
@@ -78,15 +78,23 @@ def raw_pybullet_rtf(seconds: float) -> tuple[float, float]:
         return _rates(steps * TIME_STEP, start, cpu)
 
 
-def core_rtf(seconds: float) -> tuple[float, float]:
-    """Sim seconds per wall second of SwivelCarSim, one control period per call."""
+def core_rtf(seconds: float) -> tuple[float, float, float, float]:
+    """
+    Sim seconds per wall and CPU second of SwivelCarSim, one control period per call.
+
+    While it drives, the swivel is thrown from stop to stop at full torque (reversed every
+    sim second). Also returns the largest swivel angle seen at a control period and the
+    joint's limit. # [rad]
+    """
     with SwivelCarSim() as sim:
+        torque = sim.description.swivel_torque_limit  # [N m]
+        peak = 0.0  # [rad]
         start, cpu = time.perf_counter(), time.process_time()
         while time.perf_counter() - start < seconds:
-            sim.set_command(0.0, 3.0)
+            sim.set_command(torque if int(sim.time) % 2 == 0 else -torque, 3.0)
             sim.step(5)
-            sim.state()
-        return _rates(sim.time, start, cpu)
+            peak = max(peak, abs(float(sim.state().positions[0])))
+        return (*_rates(sim.time, start, cpu), peak, sim.description.max_swivel_angle)
 
 
 def _listen(domain: int) -> None:
@@ -215,6 +223,9 @@ def main(argv: list[str] | None = None) -> None:
     print(f'raw pybullet stepSimulation : wall {raw[0]:6.1f}x  cpu {raw[1]:6.1f}x')
     print(f'physics core (SwivelCarSim) : wall {core[0]:6.1f}x  cpu {core[1]:6.1f}x  '
           f'overhead {raw[1] / core[1] - 1.0:+.0%}')
+    print(f'swivel thrown from stop to stop at full torque: at most {core[2]:.5f} rad, limit '
+          f'{core[3]:.5f} rad: {"never past" if core[2] <= core[3] + STOP_SLACK else "PAST"} '
+          f'(slack {STOP_SLACK} rad)')
     print(f'sim node, no subscribers    : wall {alone[0]:6.1f}x  cpu {alone[1]:6.1f}x  '
           f'overhead {raw[1] / alone[1] - 1.0:+.0%}  (target >= 20x)')
     ratio = raw[1] / node[1]

@@ -31,6 +31,18 @@ MAX_STEPS_PER_CALL = 100_000
 # Bullet computes in single precision here: 1 km from the origin a float32 resolves 0.06 mm,
 # still far below a wheel's contact; further out the physics degrades without a warning.
 WORLD_HALF_EXTENT = 1000.0  # [m]
+# The steering joint's hard stop: the most torque it takes to hold the joint at its limit,
+# far above the actuator's (30 N m) and what the car's weight puts on the joint.
+STOP_TORQUE = 1e5  # [N m]
+STOP_ZONE = 1e-3  # [rad] before the stop, where it holds the actuator's torque into it
+STOP_HOLD = 0.01  # [rad] the zone while engaged (a knock off the stop of 5e-4 rad rebounded 4e-3)
+# Slower than this into the stop, the joint rests on it: a torque away from it frees it.
+STOP_RATE = 0.01  # [rad/s]
+# How far past its stop the joint may still be: the solver's residual, at most 6e-5 rad
+# measured at full torque into the stop, driving or not, and 1.4e-4 rad over 180 s of sim
+# thrown from stop to stop while driving (the sim benchmark); pybullet's own joint limit alone
+# let the actuator push it 0.02-0.04 rad past.
+STOP_SLACK = 1e-3  # [rad]
 # Without URDF_USE_IMPLICIT_CYLINDER pybullet turns URDF cylinders into polygonal hulls and the
 # wheels bump over their facets (the body hopped 0.4 mm every facet, the IMU's vertical
 # specific force had a 3.4 m/s^2 standard deviation at 0.37 m/s).
@@ -208,19 +220,37 @@ class SwivelCarSim:
                              f'got {steps!r}')
         # The hot loop (every physics step): direct pybullet calls, no numpy.
         v_start = self._base_now()[2]
-        body, client, joint_ids, wheel_ids = (self._body, self._client, self._joint_ids,
-                                              self._wheel_ids)
+        body, client, joint_ids = self._body, self._client, self._joint_ids
         efforts = self._drive_train.efforts
         joint_states = self._joint_states
         self._joint_states = self._base = None
         # Sim time only grows, so a watchdog not tripped at the last step is not at any.
         may_trip = self._tripped_at(self._steps + steps - 1)
+        stop, time_step = self._swivel_stop, self._time_step  # [rad], [s]
         for _ in range(steps):
-            rl, rr, fl, fr = (joint_states[1:] if joint_states is not None else
-                              pybullet.getJointStates(body, wheel_ids, physicsClientId=client))
+            swivel, rl, rr, fl, fr = (joint_states if joint_states is not None else
+                                      pybullet.getJointStates(body, joint_ids,
+                                                              physicsClientId=client))
             joint_states = None
             self._efforts = efforts(rl, rr, fl, fr, self._swivel_torque, self._drive_speed,
                                     may_trip and self.watchdog_tripped)
+            # The steering joint's hard stop: pybullet's joint limit is soft (0.02-0.04 rad past
+            # it at full torque), so a joint about to pass its stop within the step, or pushed
+            # into it within STOP_ZONE (STOP_HOLD once on it: a knock off it may throw it back
+            # past), is made to reach it exactly by a velocity motor, solved implicitly (stiff
+            # and stable).
+            angle, rate, torque = swivel[0], swivel[1], self._efforts[0]
+            ahead = angle + rate * time_step
+            zone = STOP_HOLD if self._stop_engaged else STOP_ZONE
+            upper = ahead > stop - zone and (rate > STOP_RATE or torque > 0.0)
+            engaged = upper or (ahead < zone - stop and (rate < -STOP_RATE or torque < 0.0))
+            if engaged or self._stop_engaged:
+                target = ((stop - angle) if upper else (-stop - angle)) / time_step
+                pybullet.setJointMotorControl2(
+                    body, joint_ids[0], pybullet.VELOCITY_CONTROL,
+                    targetVelocity=target if engaged else 0.0,
+                    force=STOP_TORQUE if engaged else 0.0, physicsClientId=client)
+                self._stop_engaged = engaged
             pybullet.setJointMotorControlArray(body, joint_ids, pybullet.TORQUE_CONTROL,
                                                forces=self._efforts, physicsClientId=client)
             pybullet.stepSimulation(physicsClientId=client)
@@ -271,6 +301,9 @@ class SwivelCarSim:
         self.joint_names = (self.robot.steer_joint,) + self.robot.wheel_joints
         self._joint_ids = [names[n] for n in self.joint_names]
         self._wheel_ids = self._joint_ids[1:]
+        # The steering joint's mechanical limit, from the URDF (the description's).
+        self._swivel_stop = pb.getJointInfo(self._body, self._joint_ids[0])[9]  # [rad]
+        self._stop_engaged = False
         # Joint motors are on by default: switch them off so that torques act alone.
         pb.setJointMotorControlArray(self._body, self._joint_ids, pybullet.VELOCITY_CONTROL,
                                      forces=[0.0] * len(self._joint_ids))

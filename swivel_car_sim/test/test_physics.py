@@ -9,7 +9,7 @@ from swivel_car_model import dynamics, kinematics, planar
 from swivel_car_model.description import CarDescription
 from swivel_car_model.params import SwivelCarParams
 
-from swivel_car_sim.physics import SimConfig, SwivelCarSim
+from swivel_car_sim.physics import SimConfig, STOP_SLACK, SwivelCarSim
 from swivel_car_sim.world import StepSpec
 import yaml
 
@@ -209,6 +209,20 @@ def test_watchdog_zeroes_torque_and_stops_the_drive(sim):
     assert state.efforts[0] == 0.0
     assert abs(state.linear_velocity[0]) < 0.01
     assert np.all(np.abs(state.velocities[1:]) < 0.1)
+
+
+@pytest.mark.parametrize('torque,drive_speed', [(30.0, 0.0), (-30.0, -15.0)])
+def test_full_torque_never_turns_the_swivel_past_its_mechanical_limit(sim, torque, drive_speed):
+    limit = sim.description.max_swivel_angle
+    peak = 0.0  # [rad]
+    for _ in range(500):  # 1 s of physics steps, each checked: the overshoot is brief
+        sim.set_command(torque, drive_speed)
+        sim.step(1)
+        peak = max(peak, abs(sim.state().positions[0]))
+    assert limit - 0.01 < peak <= limit + STOP_SLACK, peak - limit
+    sim.set_command(-torque, 0.0)  # and the stop lets it go again (0.3 rad in 0.03 s)
+    sim.step(15)
+    assert abs(sim.state().positions[0]) < limit - 0.1
 
 
 def test_same_inputs_give_the_same_states():
