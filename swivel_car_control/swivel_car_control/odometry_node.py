@@ -20,9 +20,8 @@ from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Empty
 from swivel_car_control.core.joint_states import (
-    JointStateOdometry, yaw_quaternion, YAW_RATE_SOURCES)
-from swivel_car_control.core.odometry_input import (
-    GatedOdometry, MAX_SWIVEL_RATE, Verdict, WHEEL_RATE_FACTOR)
+    JointStateOdometry, MAX_SWIVEL_RATE, yaw_quaternion, YAW_RATE_SOURCES)
+from swivel_car_control.core.odometry_input import GatedOdometry, Verdict, WHEEL_RATE_FACTOR
 from swivel_car_control.joints import MissingJointError
 from swivel_car_msgs.srv import SetPose2D
 from swivel_car_ros.ros_params import (

@@ -5,9 +5,13 @@ The next message confirms it by following it; a single faulty stamp changes noth
 12).
 """
 
+import math
+
 import pytest
 from swivel_car_control.core.controller import ControllerConfig, SOURCE_CMD_VEL, SwivelController
-from swivel_car_control.core.joint_states import JointStateController, MAX_GAP, UnconfirmedStamp
+from swivel_car_control.core.joint_states import (
+    ImpossibleReading, JointStateController, LIMIT_SLACK, MAX_GAP, MAX_SWIVEL_RATE,
+    UnconfirmedStamp)
 from swivel_car_control.joints import MissingJointError
 from swivel_car_model.params import SwivelCarParams
 
@@ -66,3 +70,23 @@ def test_the_same_stamp_again_and_gaps_up_to_max_gap_are_acted_on(t):
     controller = driving(1.0)
     controller.answer(t, NAMES, [0.0], [0.0])
     assert controller.last_time == t
+
+
+LIMIT = SwivelCarParams().max_swivel_angle  # [rad] the swivel's mechanical stop
+
+
+@pytest.mark.parametrize('position,rate', [
+    (-1e12, -1e12), (-1e12, 0.0), (0.0, 1e12), (LIMIT + LIMIT_SLACK + 0.01, 0.0),
+    (0.0, -MAX_SWIVEL_RATE * 1.01), (0.0, math.inf)])
+def test_a_driver_glitch_is_refused_naming_the_joint_and_steps_nothing(position, rate):
+    # The fuzz run's glitch (-1e12 once) kicked the PID to full torque for a cycle, unsaid.
+    glitched, clean = driving(1.0), driving(1.0)
+    with pytest.raises(ImpossibleReading, match="'swivel_joint'.*driver glitch"):
+        glitched.answer(1.0 + PERIOD / 2, NAMES, [position], [rate])
+    after = glitched.answer(1.0 + PERIOD, NAMES, [0.01], [0.1])[1]
+    assert after == clean.answer(1.0 + PERIOD, NAMES, [0.01], [0.1])[1]
+
+
+def test_readings_within_the_stop_s_slack_and_the_rate_limit_pass():
+    controller = driving(1.0)
+    controller.answer(1.0 + PERIOD, NAMES, [LIMIT + LIMIT_SLACK], [MAX_SWIVEL_RATE])

@@ -10,9 +10,9 @@ import math
 from hypothesis import given, settings, strategies as st
 import pytest
 
-from swivel_car_control.core.joint_states import JointStateOdometry
+from swivel_car_control.core.joint_states import JointStateOdometry, MAX_SWIVEL_RATE
 from swivel_car_control.core.odometry_input import (
-    GatedOdometry, JointStateGate, MAX_GAP, MAX_SWIVEL_RATE, Verdict, WHEEL_RATE_FACTOR)
+    GatedOdometry, JointStateGate, MAX_GAP, Verdict, WHEEL_RATE_FACTOR)
 from swivel_car_model.description import CarDescription
 
 ROBOT = CarDescription()
@@ -152,3 +152,21 @@ def test_a_restarted_sim_goes_on_integrating_from_the_pose_it_had():
     x, _, _ = drive(before + after)
     # 1 s before, 1 s after (the restart's first message only confirms, the next starts).
     assert x == pytest.approx(2 * 2.0 * ROBOT.model_params().r, rel=0.02)
+
+
+@pytest.mark.parametrize('position,velocity', [(-1e12, 0.0), (-1e12, -1e12), (1.8, 0.0)])
+def test_a_swivel_glitch_is_refused_naming_the_joint_and_leaves_the_pose_as_without_it(
+        position, velocity):
+    clean = [(10.0 + PERIOD * k, [0.0, 2.0, 2.0]) for k in range(50)]
+    gated = GatedOdometry(JointStateOdometry(ROBOT.model_params(), *NAMES, 'swivel', 100.0),
+                          LIMITS)
+    for t, velocities in clean[:20]:
+        gated.update(t, NAMES, [0.1, 0.0, 0.0], velocities)
+    admission, due = gated.update(clean[20][0] - PERIOD / 2, NAMES, [position, 0.0, 0.0],
+                                  [velocity, 2.0, 2.0])
+    assert admission.verdict is Verdict.REFUSE and not due
+    assert "'swivel_joint'" in admission.reason and 'glitch' in admission.reason
+    for t, velocities in clean[20:]:
+        gated.update(t, NAMES, [0.1, 0.0, 0.0], velocities)
+    pose = gated.odometry.odometry
+    assert (pose.x, pose.y, pose.yaw) == drive(clean)

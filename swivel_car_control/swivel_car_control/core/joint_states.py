@@ -20,8 +20,12 @@ from swivel_car_model.planar import OffsetTricycleOdometry
 # 'swivel': the offset tricycle's steering constraint (thesis II.E); 'rear_wheels': the yaw
 # rate from the rear wheels' rate difference (the speed from the model in both cases).
 YAW_RATE_SOURCES = ('swivel', 'rear_wheels')
-# A swivel reading this far past the joint limit (compliance, sensor noise) is clamped to it.
+# A swivel reading this far past the joint limit (compliance, sensor noise) is clamped to it;
+# further past it, it is a bad reading (the joint has a hard stop there).
 LIMIT_SLACK = 0.05  # [rad]
+# A swivel turning faster than this is a bad reading: the controller commands at most a
+# few rad/s, and the swivel's torque limit cannot spin the front T much faster.
+MAX_SWIVEL_RATE = 30.0  # [rad/s]
 # Longest gap between two joint_states taken as the same run; a sim at 10 Hz or more never
 # leaves one this long, a fake stamp does.
 MAX_GAP = 1.0  # [s]
@@ -29,6 +33,38 @@ MAX_GAP = 1.0  # [s]
 
 class UnconfirmedStamp(MissingJointError):
     """The message's stamp jumped back, or ahead by more than ``MAX_GAP``: not yet trusted."""
+
+
+class ImpossibleReading(MissingJointError):
+    """A swivel reading the joint cannot give (a driver glitch): past its stop, or too fast."""
+
+
+def check_swivel_reading(name: str, names: Sequence[str], positions: Sequence[float],
+                         velocities: Sequence[float], limit: float) -> None:
+    """
+    Refuse a reading of joint ``name`` the swivel cannot physically give.
+
+    Positions [rad] and velocities [rad/s] are in the order of ``names``; ``limit`` is the
+    joint's mechanical limit [rad]. A joint or value not reported, or a non-finite position,
+    is left to ``JointReader``.
+
+    Raises
+    ------
+    ImpossibleReading
+        Naming the joint and the value.
+
+    """
+    if name not in names:
+        return
+    i = list(names).index(name)
+    position = positions[i] if i < len(positions) else math.nan  # [rad]
+    rate = velocities[i] if i < len(velocities) else math.nan  # [rad/s]
+    if math.isfinite(position) and abs(position) > limit + LIMIT_SLACK:
+        raise ImpossibleReading(f'joint {name!r} position {position!r} rad is beyond its '
+                                f'stop at {limit:.3f} rad (a driver glitch?): refused')
+    if abs(rate) > MAX_SWIVEL_RATE:
+        raise ImpossibleReading(f'joint {name!r} velocity {rate!r} rad/s is beyond '
+                                f'{MAX_SWIVEL_RATE:g} rad/s (a driver glitch?): refused')
 
 
 def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
@@ -89,8 +125,8 @@ class JointStateController:
         Raises
         ------
         swivel_car_control.joints.MissingJointError
-            No usable swivel reading, or an ``UnconfirmedStamp``; nothing was stepped (answer
-            with zero torque and drive).
+            No usable swivel reading, an ``ImpossibleReading`` or an ``UnconfirmedStamp``;
+            nothing was stepped and nothing remembered (answer with zero torque and drive).
 
         """
         last = self.last_time
@@ -102,11 +138,13 @@ class JointStateController:
             raise UnconfirmedStamp(
                 f'joint_states stamp {t:.3f} s is {abs(t - last):.3f} s {direction} the last one '
                 f'({last:.3f} s): not acted on until the next message confirms the jump')
+        name = self.swivel_joint
+        check_swivel_reading(name, names, positions, velocities, self.core.p.max_swivel_angle)
         if (self.last_time is not None and t < self.last_time) or (
                 self._reset_at is not None and t >= self._reset_at):
             self._joints.reset()
             self._reset_at = None
-        swivel = self._joints.read(t, names, positions, velocities)[self.swivel_joint]
+        swivel = self._joints.read(t, names, positions, velocities)[name]
         self.last_time = t
         return swivel, self.core.step(t, swivel.position, swivel.rate)
 
@@ -146,6 +184,12 @@ class JointStateOdometry:
         self.last_time: float | None = None  # [s] of the last joint_states used
         self._next_publish: float | None = None  # [s] joint_states time of the next odom
 
+    def check(self, names: Sequence[str], positions: Sequence[float],
+              velocities: Sequence[float]) -> None:
+        """Raise ``ImpossibleReading`` for a swivel reading past its stop or too fast."""
+        check_swivel_reading(self._names[0], names, positions, velocities,
+                             self.car.max_swivel_angle)
+
     def update(self, t: float, names: Sequence[str], positions: Sequence[float],
                velocities: Sequence[float]) -> bool:
         """
@@ -157,11 +201,12 @@ class JointStateOdometry:
         Raises
         ------
         swivel_car_control.joints.MissingJointError
-            A joint is missing; the odometry is not updated.
+            A joint is missing, or an ``ImpossibleReading``; the odometry is not updated.
         ValueError
             The model refuses the values; the odometry is not updated.
 
         """
+        self.check(names, positions, velocities)
         if self.last_time is not None and t < self.last_time:
             self._joints.reset()
             self.last_time = None

@@ -5,7 +5,8 @@ One message with a wild velocity or stamp moved the odometry for good (issue 12:
 rate of 1e300 once, or one stamp of 0 s while driving, put it metres to 1e296 m off). The
 gate refuses such a message before it reaches the integrator:
 
-- a reported velocity that is infinite or beyond what the joint can do;
+- a reported velocity that is infinite or beyond what the joint can do, a swivel position
+  past its stop (``JointStateOdometry.check``);
 - a stamp that is not after the last one integrated (a repeat is dropped quietly: the
   lockstep sim republishes a state while it waits);
 - a stamp more than ``max_gap`` after the last one.
@@ -21,15 +22,12 @@ import enum
 import math
 from typing import Mapping, Sequence
 
-from swivel_car_control.core.joint_states import JointStateOdometry, MAX_GAP
+from swivel_car_control.core.joint_states import ImpossibleReading, JointStateOdometry, MAX_GAP
 from swivel_car_model.checks import check_number
 
 # A wheel joint faster than this many times the drive's speed limit is a bad reading: an
 # open differential spins one wheel at up to twice the drive speed, skid adds a little.
 WHEEL_RATE_FACTOR = 3.0  # [1]
-# A swivel turning faster than this is a bad reading: the controller commands at most a
-# few rad/s, and the swivel's torque limit cannot spin the front T much faster.
-MAX_SWIVEL_RATE = 30.0  # [rad/s]
 
 
 class Verdict(enum.Enum):
@@ -142,6 +140,10 @@ class GatedOdometry:
             As ``JointStateOdometry.update`` (an admitted message it cannot use).
 
         """
+        try:
+            self.odometry.check(names, positions, velocities)
+        except ImpossibleReading as error:
+            return Admission(Verdict.REFUSE, str(error)), False
         last_time = self.gate.last_time
         admission = self.gate.admit(t, names, velocities)
         if admission.verdict in (Verdict.REFUSE, Verdict.REPEAT):
