@@ -29,9 +29,14 @@ def failed_tests(report: Path) -> list[str]:
         return ['(no report: pytest did not finish)']
     failed = []
     for case in ElementTree.parse(report).getroot().iter('testcase'):
-        if case.find('failure') is not None or case.find('error') is not None:
+        problem = case.find('failure')
+        problem = case.find('error') if problem is None else problem
+        if problem is not None:
             where = case.get('classname', '')
-            failed.append(f'{where}::{case.get("name")}' if where else case.get('name'))
+            name = f'{where}::{case.get("name")}' if where else case.get('name')
+            message = (problem.get('message') or '').splitlines()
+            print(f'  {name}: {message[0][:200] if message else "(no message)"}', flush=True)
+            failed.append(name)
     return failed
 
 
