@@ -45,6 +45,7 @@ from swivel_car_model import climbing, dynamics, kinematics, planar
 from swivel_car_model.params import SwivelCarParams
 
 from swivel_car_planner.core.config import PlannerConfig
+from swivel_car_planner.core.geometry import wrap_angle
 
 _SAMPLE_STEP = 0.02  # [m] base_link path between two checked poses
 _SAMPLE_TURN = 0.02  # [rad] heading change between two checked poses
@@ -265,10 +266,6 @@ def reposition_time(p: SwivelCarParams, config: PlannerConfig,
             + moves * (p.swivel_limit / config.swivel_rate + config.settle_time))
 
 
-def _wrap(angle: float) -> float:
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
-
-
 def _rotate(angle: float, x: float, y: float) -> np.ndarray:
     c, s = math.cos(angle), math.sin(angle)
     return np.array([c * x - s * y, s * x + c * y])
@@ -310,8 +307,8 @@ def _csc(p: SwivelCarParams, start: Pose, goal: Pose) -> list[tuple[Segment, ...
             offset = math.asin(-w[1] / distance)
             for theta in (bearing - offset, bearing + offset - math.pi):
                 straight = float(d @ np.array([math.cos(theta), math.sin(theta)]) + w[0])
-                turn1 = _wrap(theta - b1[2] - q1.yaw)
-                turn2 = _wrap(g2.yaw - theta - a2[2])
+                turn1 = wrap_angle(theta - b1[2] - q1.yaw)
+                turn2 = wrap_angle(g2.yaw - theta - a2[2])
                 paths.append((Segment(s1, turn1 / k1), Segment(0.0, straight),
                               Segment(s2, turn2 / k2)))
     return paths
