@@ -17,6 +17,7 @@ from rclpy.parameter import Parameter
 
 from swivel_car_control.controller_node import ControllerNode
 from swivel_car_control.odometry_node import OdometryNode
+from swivel_car_perception.step_detector_node import StepDetectorNode
 from swivel_car_planner.planner_node import PlannerNode
 from swivel_car_sim.sim_node import SimNode
 from swivel_car_testing import next_domain_id, REPO_ROOT
@@ -38,6 +39,12 @@ NODE_CASES = [
     (PlannerNode, 'ready_timeout', '-1.0'),
     (PlannerNode, 'ready_timeout', 'soon'),
     (PlannerNode, 'approach_speed', '.nan'),
+    (PlannerNode, 'max_reposition', '-1.0'),
+    (PlannerNode, 'reposition_clearance', '.nan'),
+    (PlannerNode, 'detection_max_age', '-1.0'),
+    (SimNode, 'clock_source', 'sundial'),
+    (StepDetectorNode, 'min_height', '-0.01'),
+    (StepDetectorNode, 'max_distance', 'far'),
 ]
 
 
