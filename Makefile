@@ -91,7 +91,7 @@ test: build $(FOXGLOVE_NPM)
 # test that failed and how often.
 RUNS ?= 5
 HOG ?= 0
-test-repeat: build
+test-repeat: build $(FOXGLOVE_NPM)
 	$(IN_WS) python scripts/test_repeat.py --runs $(RUNS) --workers $(PYTEST_WORKERS) \
 	    $(if $(filter 1,$(HOG)),--hog) $(PYTEST_ARGS)
 
