@@ -85,8 +85,10 @@ def test_drive_by_cmd_vel_then_climb_a_5_cm_step_on_the_system_clock(hardware_st
         assert not dead, process_report(dead)
         return False
 
+    # cmd_vel sent before the controller's subscription has matched is lost, as on the robot.
     spin_until(executor, lambda: alive() or (truth and odom and spawn.service_is_ready()
-                                             and climb.service_is_ready()),
+                                             and climb.service_is_ready()
+                                             and cmd_vel.get_subscription_count() > 0),
                START_TIMEOUT, 'the stack')
     # Stamps of the system clock, as the robot's.
     stamp = truth[-1].header.stamp

@@ -47,7 +47,6 @@ HEIGHT = 0.04  # [m]
 DISTANCE = 1.0  # [m] front axle to the edge; nearer, the planner has no room to align
 # Share of the climb's control periods the recorder must have in every stream.
 MIN_RECORDED = 0.9  # [1]
-QUIET = 0.3  # [s] wall without a message: what a paused stack had to say has come
 # Physics steps the ROS climb runs at a time (sim/run), the recorder catching up after each:
 # 50 control periods, half of what the sim's writers keep for a reader that trails them.
 RUN_STEPS = 250  # [1]
@@ -90,14 +89,6 @@ class _Recorder:
 
     def first_swivel_command(self) -> SwivelCommand:
         return deserialize_message(self.swivel_commands[0], SwivelCommand)
-
-    def drain(self, session: SimSession) -> None:
-        """Spin until nothing new has come for ``QUIET``: a paused sim's messages are in."""
-        while True:
-            before = self.heard
-            _spin_for(session, QUIET)
-            if self.heard == before:
-                return
 
     def heard_until(self, end: float) -> bool:
         """Every recorded stream has reached the stamp ``end`` [s] (each comes in order)."""
@@ -151,8 +142,12 @@ def _ros_climb(session: SimSession, recorder: _Recorder, request: ClimbStep.Requ
     session.set_paused(False)
     session.wait_ready()  # until the planner hears the stack
     session.set_paused(True)
-    recorder.drain(session)
-    paused = next(reversed(recorder.joints))  # [s] the state the sim stopped at
+    # One period stepped from the pause: its answer names the state the sim then holds, however
+    # late this node hears the states before it.
+    held = step_client.call_async(StepSimulation.Request(steps=sim.steps_per_period))
+    session.spin_until(held.done, 30.0, 'sim/step')
+    assert held.result().success, held.result().message
+    paused = _seconds(held.result().sim_time)  # [s] the state the sim stopped at
     # Outside the chain the odometry may trail the sim: reset it once it has that state.
     session.spin_until(lambda: paused in recorder.commands and paused in recorder.odometry,
                        30.0, 'the controller and odometry to answer the paused state')
@@ -183,11 +178,6 @@ def _ros_climb(session: SimSession, recorder: _Recorder, request: ClimbStep.Requ
     end = first_tick + result.outcome.duration - 0.5 * sim.control_period  # [s]
     session.spin_until(lambda: recorder.heard_until(end), 30.0, 'the recorded messages')
     return result, first_tick
-
-
-def _spin_for(session: SimSession, seconds: float) -> None:
-    end = time.monotonic() + seconds
-    session.spin_until(lambda: time.monotonic() > end, seconds + 10.0, 'a moment')
 
 
 @pytest.fixture
