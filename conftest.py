@@ -11,12 +11,15 @@ Hypothesis draws the same examples on every run, so a test run's result depends 
 alone (HYPOTHESIS_PROFILE=explore draws new ones, for looking for bugs by hand). Neither has a
 deadline: an example's wall time depends on the machine's load (one took 414 ms against the
 default 200 ms with three test processes on two cores).
+
+The files pytest.ini names in ``run_first`` are collected first, in that order.
 """
 
 import importlib
 import os
 
 from hypothesis import settings
+import pytest
 
 for package in ('swivel_car_bringup', 'swivel_car_control', 'swivel_car_model',
                 'swivel_car_perception', 'swivel_car_planner', 'swivel_car_ros',
@@ -26,3 +29,17 @@ for package in ('swivel_car_bringup', 'swivel_car_control', 'swivel_car_model',
 settings.register_profile('deterministic', derandomize=True, deadline=None)
 settings.register_profile('explore', derandomize=False, deadline=None)
 settings.load_profile(os.environ.get('HYPOTHESIS_PROFILE', 'deterministic'))
+
+
+def pytest_addoption(parser):
+    parser.addini('run_first', 'test files collected before the others, in this order',
+                  type='linelist')
+
+
+def pytest_collection_modifyitems(config, items):
+    first = config.getini('run_first')
+    missing = [path for path in first if not (config.rootpath / path).is_file()]
+    if missing:
+        raise pytest.UsageError(f'pytest.ini run_first names no such file: {missing}')
+    rank = {path: index for index, path in enumerate(first)}
+    items.sort(key=lambda item: rank.get(item.location[0], len(first)))
