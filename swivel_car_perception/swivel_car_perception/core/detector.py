@@ -32,11 +32,16 @@ from swivel_car_model.description import CarDescription
 # edge's pixel footprint at 2 m (18 mm) plus three depth sigmas there (45 mm).
 RISER_BAND = 0.06  # [m]
 ENDS_PROBE = 0.04  # [m] how far past an end of the edge the camera must see ground
+RISER_SLACK = 0.005  # [m] a riser point past the edge line beyond its depth error
 # The front wheels reach this far ahead of the front axle's ground contact when the swivel
 # turns them (a wheel of radius r, swung forward by up to about 0.1 m): the camera sees
 # them, and nothing nearer counts as a step.
 SELF_REACH_MARGIN = 0.1  # [m]
-GROUND_HYPOTHESES = 80  # planes tried for the ground (three points each)
+GROUND_HYPOTHESES = 80  # planes tried for the ground (through its point below the car)
+NEAREST_SHARE = 4  # half the planes through two of the nearest quarter of the points
+# A point this far under a plane, and three of its depth errors, is below it: the ground has
+# none below it; a plane sloping from it onto a step's top face has the ground in front.
+BELOW_MARGIN = 0.003  # [m]
 MAX_TILT = 0.2  # [rad] steepest ground plane: the car pitched or rolled on flat ground
 
 
@@ -285,10 +290,15 @@ class StepDetector:
         """
         Fit the ground plane: (upward unit normal, offset so that n.p + d = height, std).
 
-        Planes through three points near where the ground should be (within ``ground_band``
-        of it: a car tilted by up to about 3 degrees), none steeper than ``MAX_TILT``; of
-        those with at least half the best one's support, the lowest (a near step's top face
-        can be as large as the ground in view, never below it). Then least squares on every
+        The car stands on the ground: its rear wheels touch it, so the ground passes
+        ``ground_height`` below base_link's origin however the swivel pitches or rolls the
+        car. Planes through that point and two points near where the ground should be
+        (within ``ground_band`` of it), half of them two of the nearest points in view (the
+        ground in front of a near step, which its top face can outnumber several times),
+        none steeper than ``MAX_TILT``; of those supported by at least ``min_ground_points``
+        points, those with the fewest points clearly below them (the ground has none; a
+        step's top face, or a plane sloping from the ground onto it, has the ground in front
+        of the step below it), of those the best supported. Then least squares on every
         point near that plane, weighted by the depth variance, refitted on its inliers.
         """
         cfg, mount = self.config, self.mount
@@ -296,23 +306,31 @@ class StepDetector:
         if near.sum() < cfg.min_ground_points:
             return None
         candidates = points[near]
+        foot = np.array([0.0, 0.0, -mount.ground_height])  # [m] base_link's origin's foot
+        nearest = np.argsort(candidates[:, 0], kind='stable')[
+            :max(2, len(candidates) // NEAREST_SHARE)]
         rng = np.random.default_rng(0)  # the same hypotheses for the same image
-        triples = candidates[rng.integers(0, len(candidates), (GROUND_HYPOTHESES, 3))]
-        normals = np.cross(triples[:, 1] - triples[:, 0], triples[:, 2] - triples[:, 0])
+        pairs = rng.integers(0, len(candidates), (GROUND_HYPOTHESES, 2))
+        pairs[:GROUND_HYPOTHESES // 2] = nearest[
+            rng.integers(0, len(nearest), (GROUND_HYPOTHESES // 2, 2))]
+        normals = np.cross(candidates[pairs[:, 0]] - foot, candidates[pairs[:, 1]] - foot)
         length = np.linalg.norm(normals, axis=1)
         usable = length > 1e-9
         normals = normals[usable] / length[usable, None] * np.sign(normals[usable, 2:3])
-        offsets = -np.einsum('ij,ij->i', normals, triples[usable, 0])
+        offsets = -normals @ foot
         upright = normals[:, 2] > math.cos(MAX_TILT)
         normals, offsets = normals[upright], offsets[upright]
         if len(normals) == 0:
             return None
-        support = (np.abs(candidates @ normals.T + offsets) < 0.01).sum(axis=0)
-        good = support >= support.max() / 2.0
-        # Height of each plane below base_link's origin, where the camera looks: the lowest.
-        probe = np.array([mount.front_axle + 0.5, 0.0])
-        level = -(normals[:, 0] * probe[0] + normals[:, 1] * probe[1] + offsets) / normals[:, 2]
-        best = int(np.argmin(np.where(good, level, np.inf)))
+        residual = candidates @ normals.T + offsets  # [m] each point (row) above each plane
+        support = (np.abs(residual) < 0.01).sum(axis=0)
+        sigma = cfg.sigma_per_metre_squared * z[near] ** 2  # [m] each point's depth error
+        below = (residual < -(BELOW_MARGIN + 3.0 * sigma[:, None])).sum(axis=0)
+        supported = support >= cfg.min_ground_points
+        if not supported.any():
+            return None
+        fewest = below[supported].min()
+        best = int(np.argmax(np.where(supported & (below == fewest), support, -1)))
         fit = normals[best], float(offsets[best])
         weights = 1.0 / (cfg.sigma_per_metre_squared * z ** 2 + 1e-3) ** 2
         threshold = 0.01
@@ -367,9 +385,13 @@ class StepDetector:
         if best is None:
             return None
         _, x0, slope = best
+        # Past the line, only as far as a riser point's depth error reaches: further, the
+        # top face's points, which would draw the line onto the top (by 1.3-1.6 cm for a
+        # 2 cm riser, whose raised part is a few pixels high).
+        beyond = np.minimum(RISER_BAND / 2.0, RISER_SLACK + 3.0 * sigma)  # [m]
         for _ in range(3):
             residual = flat[:, 0] - x0 - slope * flat[:, 1]
-            riser = (residual > -RISER_BAND / 2.0) & (residual < RISER_BAND / 2.0)
+            riser = (residual > -RISER_BAND / 2.0) & (residual < beyond)
             if riser.sum() < cfg.min_riser_points:
                 return None
             weights = 1.0 / (sigma[riser] ** 2 + 1e-6)
