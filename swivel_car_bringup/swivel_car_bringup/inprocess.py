@@ -680,7 +680,8 @@ class InProcessStack:
         self._steps = []
         self._detected_climb = use_detected_step
         if use_detected_step:
-            detected, why = (self.detection.planner.request(request, start)
+            detected, why = (self.detection.planner.request(request, start,
+                                                            self.config.whole_car_limit)
                              if self.detection is not None
                              else (None, 'the depth camera is off (enable_detection)'))
             if detected is None:

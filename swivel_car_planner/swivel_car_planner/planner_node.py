@@ -341,7 +341,7 @@ class PlannerNode(Node):
         With ``use_detected_step`` the step is the detector's (its geometry fields ignored).
         """
         if use_detected_step:
-            detected, why = self._detected.request(request, self._now())
+            detected, why = self._detected.request(request, self._now(), self.whole_car_limit)
             if detected is None:
                 answer(self._failure(ErrorCode.NO_STEP_DETECTED, why))
                 return

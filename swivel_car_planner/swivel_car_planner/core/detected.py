@@ -95,16 +95,21 @@ class DetectedSteps:
                           'present pose')
         return moved(detection, then, latest[1], self.front_axle), ''
 
-    def request(self, request: ClimbRequest, now: float) -> tuple[ClimbRequest | None, str]:
+    def request(self, request: ClimbRequest, now: float,
+                limit: float = math.inf) -> tuple[ClimbRequest | None, str]:
         """
         Return ``request`` with the fresh detection's step, or None and why (one line).
 
         An end the camera did not see is taken ``UNSEEN_REACH`` beyond the part it saw;
-        neither end seen: the width is not known (0).
+        neither end seen: the width is not known (0). A height above the whole car's
+        ``limit`` [m] by no more than twice its one-sigma is the limit's: the detection
+        cannot tell that step from one at the limit.
         """
         d, why = self.fresh(now)
         if d is None:
             return None, why
+        if limit < d.height <= limit + 2.0 * d.height_std:
+            d = replace(d, height=limit)
         left = d.offset + d.width / 2.0 + (0.0 if d.left_end_seen else UNSEEN_REACH)  # [m]
         right = d.offset - d.width / 2.0 - (0.0 if d.right_end_seen else UNSEEN_REACH)
         if not (d.left_end_seen or d.right_end_seen):
