@@ -122,7 +122,8 @@ def test_drive_by_cmd_vel_then_climb_a_5_cm_step_on_the_system_clock(hardware_st
         plan_only=False))
     spin_until(executor, lambda: alive() or answer.done(), CLIMB_TIMEOUT, 'climb_step')
     result = answer.result()
-    assert result.success, f'{result.error_code}: {result.message}'
+    assert result.success, f'{result.error_code}: {result.message}\n' + process_report(
+        processes, 4000)
     final = GroundTruth.from_msg(truth[-1])
     assert final.four_wheels_on_top(STEP_HEIGHT, p.r), final
     assert final.x - p.h * abs(final.yaw) > edge_x, (final, edge_x)
