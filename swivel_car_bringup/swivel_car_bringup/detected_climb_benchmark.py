@@ -5,12 +5,13 @@ Climbs on a detected step beside climbs on the given step, on the same draws.
 The climb benchmark's randomised requests (``climb_benchmark.RequestRanges``; each height's
 draws from its own seed, as the climb benchmark's default run draws them, so a height run
 alone or in a process of its own climbs the same steps): each draw is climbed twice through
-the in-process stack, from the same start: once told the step (the climb benchmark's column),
-once with ``use_detected_step`` (the sim's depth camera with
-its noise, the step detector, the planner taking the latest detection). Draws the planner
-refuses as placed when told the step (no room) are drawn again, as the climb benchmark does.
-Judged by the sim's ground truth: all four wheels on top. Each detected climb's line shows the
-detection it started from beside the true step. Prints, asserts nothing.
+the in-process stack, from the same start: once told the step (the climb benchmark's column,
+without the camera), once with ``use_detected_step`` (the sim's depth camera with its noise,
+the step detector and its fusion started afresh, the planner taking the latest detection).
+Draws the planner refuses as placed when told the step (no room) are drawn again, as the climb
+benchmark does. Judged by the sim's ground truth: all four wheels on top. Each detected
+climb's line shows the detection it started from beside the true step. Prints, asserts
+nothing.
 """
 
 from __future__ import annotations
@@ -62,7 +63,6 @@ def run(heights: list[float], trials: int, seed: int, max_draws: int) -> None:
     ranges = RequestRanges()
     table = []
     with InProcessStack() as stack:
-        stack.enable_detection(seed)
         for height in heights:
             rng = random.Random(height_seed(seed, height))
             given = detected = refused = attempted = drawn = 0
@@ -70,12 +70,14 @@ def run(heights: list[float], trials: int, seed: int, max_draws: int) -> None:
                 drawn += 1
                 distance, yaw, width, offset = ranges.draw(rng)
                 stack.reset()
+                stack.detection = None  # told: no camera, as the climb benchmark climbs
                 told = climb_trial(stack, height, distance, yaw, width, offset)
                 if told.code == ErrorCode.INVALID_REQUEST:
                     continue
                 attempted += 1
                 given += told.four
                 stack.reset()
+                stack.enable_detection(seed)  # a fresh camera and detector, as reset's nodes
                 code, message, four, said = detected_trial(stack, height, distance, yaw,
                                                            width)
                 detected += four
