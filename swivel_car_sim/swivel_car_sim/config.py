@@ -28,11 +28,18 @@ PARAMETERS: dict[str, tuple[object, str]] = {
                               'as possible'),
     'lockstep': (False, 'advance one control_period per ActuatorCommand stamped with the '
                         'last joint_states stamp'),
-    'lockstep_timeout': (1.0, '[s] wall time to wait for the command in lockstep; then the '
-                              'sim runs at real time until a command comes; 0 = wait forever'),
+    'lockstep_timeout': (1.0, '[s] wall time to wait for the command in lockstep (or free '
+                              'running, see max_command_age); then the sim runs at real time '
+                              '(free running: at real_time_factor) until a command comes; 0 = '
+                              'wait forever'),
     'lockstep_real_time_factor': (0.0, '[1] in lockstep, at most this much sim time per wall '
                                        'time, so that nodes outside the lockstep keep up; '
                                        '0 = as fast as the controller answers'),
+    'max_command_age': (0.01, '[s] sim time; free running with clock_source sim: the sim '
+                              'steps on from a state only while its newest actuator_command '
+                              'answers a state at most this much older, else it waits for the '
+                              'controller (at most lockstep_timeout), and it drops older '
+                              'commands; 0 = the command of the state itself'),
     'watchdog_timeout': (0.5, '[s] sim time without a command after which the swivel torque '
                               'is zeroed and the drive stops; 0 disables'),
     'robot_variant': ('swivel', "'swivel' or 'car_like' (baseline with a steered front axle)"),
@@ -82,6 +89,7 @@ class SimNodeConfig:
     lockstep: bool
     lockstep_timeout: float  # [s]
     lockstep_real_time_factor: float  # [1]
+    max_command_age: float  # [s] sim time
     initial_pose: tuple[float, float, float]  # [m], [m], [rad]
     start_paused: bool
     clock_every: int  # [1]
@@ -149,8 +157,9 @@ class SimNodeConfig:
         if v['lockstep_real_time_factor'] < 0.0:
             raise ValueError('lockstep_real_time_factor must be >= 0, got '
                              f'{v["lockstep_real_time_factor"]!r}')
-        if v['lockstep_timeout'] < 0.0:
-            raise ValueError(f'lockstep_timeout must be >= 0, got {v["lockstep_timeout"]!r}')
+        for name in ('lockstep_timeout', 'max_command_age'):
+            if v[name] < 0.0:
+                raise ValueError(f'{name} must be >= 0, got {v[name]!r}')
         every = {}
         for name in ('clock_rate', 'imu_rate', 'ground_truth_rate'):
             if v[name] <= 0.0:
@@ -161,6 +170,7 @@ class SimNodeConfig:
                    steps_per_period=steps, real_time_factor=v['real_time_factor'],
                    lockstep=v['lockstep'], lockstep_timeout=v['lockstep_timeout'],
                    lockstep_real_time_factor=v['lockstep_real_time_factor'],
+                   max_command_age=v['max_command_age'],
                    initial_pose=(v['initial_x'], v['initial_y'], v['initial_yaw']),
                    start_paused=v['start_paused'], clock_every=every['clock_rate'],
                    imu_every=every['imu_rate'],

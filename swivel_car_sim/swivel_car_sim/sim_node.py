@@ -28,6 +28,7 @@ from swivel_car_ros.lockstep import SimLockstep
 from swivel_car_ros.ros_params import run_node, STATE_QUEUE_DEPTH
 from swivel_car_ros.serialized import read_logged
 from swivel_car_sim.camera_publisher import CameraPublisher
+from swivel_car_sim.command_pace import CommandPace
 from swivel_car_sim.config import PARAMETERS, SimNodeConfig
 from swivel_car_sim.conversions import (
     actuator_command_fields, sim_time, sim_time_msg, StateMessages)
@@ -39,10 +40,14 @@ from swivel_car_sim.world import StepSpec
 # With real_time_factor 0 one timer callback steps for at most this long, then yields to
 # the executor so that commands and service calls are never starved.
 FAST_BATCH_WALL_TIME = 0.005  # [s]
+# With real_time_factor 0, how often a sim waiting (paused, or for its controller) looks
+# whether it may run again; a command or a resume restarts it at once.
+FAST_WAIT_PERIOD = 0.02  # [s] wall
 # How the log says that the controller stopped answering, and that it answers again: a
 # supervisor (or a test) reads them to tell whether the sim hears the controller.
 LOCKSTEP_TIMED_OUT_LOG = 'lockstep: no actuator_command'
 LOCKSTEP_RESUMED_LOG = 'lockstep: actuator_command again'
+PACE_TIMED_OUT_LOG = 'free running: no actuator_command'
 
 
 class SimNode(Node):
@@ -83,6 +88,12 @@ class SimNode(Node):
         self._commands = DelayedCommands(cfg.physics.time_step)
         self._wall = (WallPacer(round(cfg.control_period * 1e9), 0, time.time_ns())
                       if cfg.wall_clock else None)
+        # Free running on sim time: never ahead of the controller by more than
+        # max_command_age (a board on the system clock waits for no one).
+        self._pace = (CommandPace(round(cfg.max_command_age * 1e9),
+                                  round(cfg.lockstep_timeout * 1e9), time.monotonic_ns())
+                      if not (cfg.lockstep or cfg.wall_clock) else None)
+        self._fast_timer = None
 
         self._clock_pub = self.create_publisher(ClockMsg, '/clock', 10)
         self._joint_pub = self.create_publisher(JointState, 'joint_states', STATE_QUEUE_DEPTH)
@@ -110,7 +121,8 @@ class SimNode(Node):
             self.create_timer(cfg.control_period / cfg.real_time_factor, self._advance_if_running,
                               clock=wall)
         else:
-            self.create_timer(0.0, self._on_fast_timer, clock=wall)
+            self._fast_timer = self.create_timer(0.0, self._on_fast_timer, clock=wall)
+            self.create_timer(FAST_WAIT_PERIOD, self._wake_fast_timer, clock=wall)
         self._publish_state()
         self.get_logger().info(
             f'{cfg.physics.robot_variant} car, time_step {cfg.physics.time_step} s, control '
@@ -153,8 +165,21 @@ class SimNode(Node):
                 return
 
     def _advance_if_running(self) -> None:
-        if not self._lockstep.paused:
+        if not self._lockstep.paused and self._may_step():
             self._advance()
+
+    def _may_step(self) -> bool:
+        """Free running: tell whether the controller's newest command lets the sim step on."""
+        if self._pace is None:
+            return True
+        timed_out = self._pace.timed_out
+        if self._pace.may_step(self.sim.steps * self._time_step_ns, time.monotonic_ns()):
+            if self._pace.timed_out and not timed_out:
+                self.get_logger().warn(
+                    f'{PACE_TIMED_OUT_LOG} for {self.config.lockstep_timeout} s (wall): '
+                    'running on without one until one comes', throttle_duration_sec=5.0)
+            return True
+        return False
 
     def _on_wall_timer(self) -> None:
         if self._lockstep.paused:
@@ -175,8 +200,18 @@ class SimNode(Node):
 
     def _on_fast_timer(self) -> None:
         deadline = time.monotonic() + FAST_BATCH_WALL_TIME
-        while not self._lockstep.paused and time.monotonic() < deadline:
+        while time.monotonic() < deadline:
+            if self._lockstep.paused or not self._may_step():
+                # Waiting: no zero-period timer spinning meanwhile (it took a core from the
+                # controller it waits for); a command, a resume or _wake_fast_timer restarts it.
+                self._fast_timer.cancel()
+                return
             self._advance()
+
+    def _wake_fast_timer(self) -> None:
+        if (self._fast_timer.is_canceled() and not self._lockstep.paused
+                and self._may_step()):
+            self._fast_timer.reset()
 
     def _on_lockstep_timer(self) -> None:
         tick = self._lockstep.tick(time.monotonic_ns())
@@ -239,6 +274,8 @@ class SimNode(Node):
             return  # it answers a state of the world before the last reset
         if self._stale(computed):
             return
+        if self._fast_timer is not None:
+            self._wake_fast_timer()
         if self._sensors is None:
             if not self._apply(swivel_torque, drive_speed):
                 return
@@ -269,32 +306,48 @@ class SimNode(Node):
         """
         Tell whether a command stamped ``computed`` [ns] is too old to apply.
 
-        A free-running sim drops a command computed more than ``watchdog_timeout`` of sim
-        time ago: it answers a state that old, and applying it steers open loop (at
-        ``real_time_factor`` 0 the controller falls 20x behind and the car spins). The watchdog
-        then stops the car. An unstamped command (stamp 0) counts as fresh.
+        Free running on sim time, older than ``max_command_age`` (``CommandPace``: the sim
+        waits for its controller, so only a controller catching up after its timeout sends
+        such); on the system clock, older than ``watchdog_timeout``: it answers a state that
+        old, and applying it would steer open loop. The sim goes on with the command it has
+        (the pace or the watchdog stops it). An unstamped command (stamp 0) counts as fresh.
         """
-        watchdog = self.config.physics.watchdog_timeout
-        age = (self._stamp_ns() - computed) * 1e-9  # [s]
-        if self.config.lockstep or watchdog == 0.0 or computed == 0 or age <= watchdog:
+        if self.config.lockstep or computed == 0:
             return False
+        age_ns = self._stamp_ns() - computed  # [ns]
+        if self._pace is not None:
+            self._pace.heard(computed, time.monotonic_ns())
+            if not self._pace.stale(computed, self._stamp_ns()):
+                return False
+            bound = f'max_command_age {self.config.max_command_age} s'
+        else:
+            watchdog = self.config.physics.watchdog_timeout
+            if watchdog == 0.0 or age_ns <= watchdog * 1e9:
+                return False
+            bound = f'watchdog_timeout {watchdog} s'
         clock = 'sim' if self._wall is None else 'system clock'
         self.get_logger().warn(
-            f'dropping actuator_command computed {age:.2f} s of {clock} time ago '
-            f'(watchdog_timeout {watchdog} s): the controller is behind the sim; free running '
-            f'with real_time_factor {self.config.real_time_factor}, lockstep keeps them '
-            'together', throttle_duration_sec=5.0)
+            f'dropping actuator_command computed {age_ns * 1e-9:.3f} s of {clock} time ago '
+            f'({bound}): the controller is behind the sim', throttle_duration_sec=5.0)
         return True
 
     def _on_set_paused(self, request: SetBool.Request, response: SetBool.Response):
         advance = self._lockstep.set_paused(request.data, time.monotonic_ns())
         if self._wall is not None and not request.data:
             self._wall.restart(self.sim.steps * self._time_step_ns, time.time_ns())
+        self._resumed()
         response.success = True
         response.message = 'paused' if request.data else 'running'
         if advance:
             self._advance()
         return response
+
+    def _resumed(self) -> None:
+        """Free running: after a pause the wait for the controller counts afresh."""
+        if self._pace is not None and not self._lockstep.paused:
+            self._pace.restart(time.monotonic_ns())
+            if self._fast_timer is not None:
+                self._wake_fast_timer()
 
     @staticmethod
     def _steps_refusal(steps: int) -> str | None:
@@ -338,6 +391,7 @@ class SimNode(Node):
             return response
         periods = -(-request.steps // self.config.steps_per_period)  # rounded up
         advance = self._lockstep.run_for(periods, time.monotonic_ns())
+        self._resumed()
         pause_at_ns = self._lockstep.pause_at_ns  # [ns]
         response.success = True
         response.message = (f'running {periods} control periods, then pausing at '

@@ -17,7 +17,8 @@ from std_msgs.msg import Header
 from std_srvs.srv import SetBool
 from swivel_car_msgs.msg import ActuatorCommand, StepObstacle
 from swivel_car_msgs.srv import RemoveObstacle, ResetSimulation, SpawnObstacle, StepSimulation
-from swivel_car_sim.sim_node import LOCKSTEP_RESUMED_LOG, LOCKSTEP_TIMED_OUT_LOG, SimNode
+from swivel_car_sim.sim_node import (LOCKSTEP_RESUMED_LOG, LOCKSTEP_TIMED_OUT_LOG,
+                                     PACE_TIMED_OUT_LOG, SimNode)
 from swivel_car_testing import next_domain_id, spin_until
 
 TIMEOUT = 20.0  # [s] wall guard against a hang, not a measurement
@@ -182,22 +183,90 @@ def test_real_time_free_running_advances_and_applies_commands(harness_factory):
     assert h.joint_states[-1].velocity[1] > 1.0
 
 
-def test_free_running_drops_a_command_computed_longer_ago_than_the_watchdog(harness_factory):
+def test_free_running_drops_a_command_computed_longer_ago_than_max_command_age(
+        harness_factory):
     # Paused and stepped by hand: free running (no lockstep), but deterministic.
-    h = harness_factory(real_time_factor=0.0, start_paused=True, watchdog_timeout=0.5)
-    step = StepSimulation.Request(steps=300)  # 0.6 s
-    assert h.call(StepSimulation, 'step', step).success
-    h.command(Time(sec=0, nanosec=50_000_000), drive_speed=5.0)  # 0.55 s old
+    h = harness_factory(real_time_factor=0.0, start_paused=True, max_command_age=0.01)
+    assert h.call(StepSimulation, 'step', StepSimulation.Request(steps=300)).success  # 0.6 s
+    h.command(Time(sec=0, nanosec=580_000_000), drive_speed=5.0)  # 0.02 s old
     spin_until(h.executor, lambda: h.sim.sim.time > 0.0 and h.joint_states, TIMEOUT, 'states')
     for _ in range(20):
         h.executor.spin_once(timeout_sec=0.01)
+    step = StepSimulation.Request(steps=100)
     assert h.call(StepSimulation, 'step', step).success
     assert abs(h.sim.sim.state().velocities[1]) < 0.1
-    h.command(Time(sec=1, nanosec=100_000_000), drive_speed=5.0)  # 0.1 s old: applied
+    h.command(Time(sec=0, nanosec=800_000_000), drive_speed=5.0)  # the state's own: applied
     for _ in range(20):
         h.executor.spin_once(timeout_sec=0.01)
-    assert h.call(StepSimulation, 'step', StepSimulation.Request(steps=100)).success
+    assert h.call(StepSimulation, 'step', step).success
     assert h.sim.sim.state().velocities[1] > 1.0
+
+
+# The test controller's swivel torque names the state it answers (1 mN m per period of its
+# stamp, at most 0.1 N m here: a nudge beside the 5-10 N m that hold the swivel), and each
+# joint_states reports the torque applied (effort): so the age of the command the sim applied
+# over every period is read from what the sim publishes.
+STAMP_TORQUE = 1e-3  # [N m] per control period
+
+
+def _answer_naming_the_stamp(h: Harness, until_ns: int) -> list[tuple[int, int]]:
+    """
+    Answer every new state as a controller would, until sim time ``until_ns`` [ns].
+
+    Returns (stamp, stamp of the command applied in the period before it) [ns] of each state.
+    """
+    applied, seen, answered = [], 0, 10_000_000
+    while not applied or applied[-1][0] < until_ns:
+        h.executor.spin_once(timeout_sec=0.05)
+        for msg in h.joint_states[seen:]:
+            stamp = _ns(msg.header.stamp)
+            if msg.effort[0] != 0.0:  # 0: before the first command
+                applied.append((stamp, round(msg.effort[0] / STAMP_TORQUE) * 10_000_000))
+            if stamp > answered:
+                answered = stamp
+                h.command(msg.header.stamp, swivel_torque=stamp / 10_000_000 * STAMP_TORQUE,
+                          drive_speed=3.0)
+        seen = len(h.joint_states)
+    return applied
+
+
+def _answer_a_stamped_state_and_resume(h: Harness) -> None:
+    """Step one period (a command stamped 0 counts as unstamped), answer it, resume."""
+    assert h.call(StepSimulation, 'step', StepSimulation.Request(steps=5)).success
+    spin_until(h.executor, lambda: h.joint_states and _ns(h.joint_states[-1].header.stamp),
+               TIMEOUT, 'the stepped state')
+    h.command(h.joint_states[-1].header.stamp, swivel_torque=STAMP_TORQUE, drive_speed=3.0)
+    spin_until(h.executor, lambda: h.sim._pace.newest_ns, TIMEOUT, 'the command heard')
+    assert h.call(SetBool, 'set_paused', SetBool.Request(data=False)).success
+
+
+@pytest.mark.parametrize('max_command_age', [0.0, 0.01])
+def test_free_running_at_real_time_factor_0_never_runs_ahead_of_its_controller(
+        harness_factory, max_command_age):
+    # Issue 32: as fast as possible the sim ran 20x ahead of the controller and applied
+    # commands computed up to watchdog_timeout (0.5 s) of sim time before: the swivel loop
+    # closed over that delay and the car yawed back and forth at 3.5 rad/s. A protocol bound:
+    # the sim steps on from the state of t only with a command answering t - max_command_age
+    # or later, so over any period the command applied is at most one period older than that.
+    h = harness_factory(real_time_factor=0.0, start_paused=True, lockstep_timeout=0.0,
+                        max_command_age=max_command_age)
+    _answer_a_stamped_state_and_resume(h)
+    applied = _answer_naming_the_stamp(h, 1_000_000_000)
+    ages = [stamp - command for stamp, command in applied]  # [ns]
+    assert max(ages) <= round(max_command_age * 1e9) + 10_000_000, applied
+    assert len(applied) >= 99, applied  # it ran, and no state was lost to the queue
+    assert min(ages) >= 10_000_000  # no command applied before the state it answers
+
+
+def test_free_running_without_its_controller_waits_lockstep_timeout_then_runs_on(
+        harness_factory, capfd):
+    h = harness_factory(real_time_factor=0.0, start_paused=True, lockstep_timeout=0.2)
+    _answer_a_stamped_state_and_resume(h)
+    # Then no answer: the sim waits (a wall-time wait, so only its end is checked: it comes,
+    # and the watchdog has stopped the car once the sim ran on without the controller).
+    spin_until(h.executor, lambda: h.sim.sim.time > 1.0, TIMEOUT, 'running on')
+    assert h.sim.sim.watchdog_tripped
+    assert f'{PACE_TIMED_OUT_LOG} for 0.2 s' in capfd.readouterr().err
 
 
 def test_step_service_advances_lockstep_without_a_controller(harness_factory):
