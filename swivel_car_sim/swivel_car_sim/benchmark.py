@@ -14,7 +14,12 @@ Prints, from one run on this machine:
    and the publisher then also paid for reliable-QoS repairs: +254-258 % against +186-208 %
    in alternating runs);
 4. the installed sim_node executable in its own process (real_time_factor 0), its speed seen
-   through /clock by this process (which then also pays for receiving the clock).
+   through /clock by this process (which then also pays for receiving the clock);
+5. the installed sim_node (real_time_factor 0) with the installed controller_node, commanded
+   on a 1 m circle by cmd_vel at 50 Hz of wall time (as a teleop sends it), with the default
+   ``max_command_age`` and with 0.5 s (the watchdog's time, as unbounded as the sim was
+   before): the yaw rate's range and sign changes, the circle's radius, the swivel's largest
+   angle against its mechanical limit, from the ground truth (sim time).
 
 Real-time factor = sim time / wall time. Node overhead = extra CPU time of this process per
 sim second of (3) over (1), as a fraction of (1); the ratio printed is (3)'s CPU per sim
@@ -25,6 +30,7 @@ second over (1)'s. Targets (issue 15): with every topic subscribed, overhead < 3
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import signal
 import subprocess
@@ -33,22 +39,29 @@ import time
 
 from ament_index_python.packages import get_package_prefix
 
+from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
 import pybullet
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
+from rclpy.serialization import deserialize_message
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
 from std_srvs.srv import SetBool
 
+from swivel_car_sim.config import PARAMETERS
 from swivel_car_sim.physics import STOP_SLACK, SwivelCarSim
 from swivel_car_sim.sim_node import SimNode
 
 TIME_STEP = 0.002  # [s]
 DOMAIN = 231  # ROS domain of the benchmark's nodes, above the tests' 1..230 blocks
 TARGET_OVERHEAD = 0.30  # [1] sim node over raw stepping, every topic subscribed (issue 15)
+# The circle of (5): 0.3 m/s at 0.3 rad/s; its first seconds (the swivel turning in, the
+# drive speeding up) are left out of the figures.
+CIRCLE = (0.3, 0.3)  # [m/s], [rad/s]
+CIRCLE_SETTLE = 2.0  # [s] sim
 TOPICS = ((Clock, '/clock'), (JointState, 'joint_states'), (Imu, 'imu'),
           (Odometry, 'ground_truth/odom'))
 
@@ -166,12 +179,18 @@ def node_rtf(seconds: float, listener: bool) -> tuple[float, float]:
             listener.wait(10)
 
 
+def _executable(package: str, name: str) -> str | None:
+    """Return an installed executable's path, None if its package is not installed."""
+    try:
+        return os.path.join(get_package_prefix(package), 'lib', package, name)
+    except Exception:  # not installed: skip the figure
+        return None
+
+
 def process_rtf(seconds: float) -> float | None:
     """Sim seconds per wall second of the installed sim_node process, seen through /clock."""
-    try:
-        executable = os.path.join(get_package_prefix('swivel_car_sim'), 'lib', 'swivel_car_sim',
-                                  'sim_node')
-    except Exception:  # not installed: skip this figure
+    executable = _executable('swivel_car_sim', 'sim_node')
+    if executable is None:
         return None
     process = subprocess.Popen([executable, '--ros-args', '-p', 'real_time_factor:=0.0'],
                                env=_environment(DOMAIN), stdout=subprocess.DEVNULL,
@@ -204,19 +223,135 @@ def process_rtf(seconds: float) -> float | None:
         process.wait(10)
 
 
+def closed_loop_circle(sim_seconds: float, max_command_age: float) -> dict | None:
+    """
+    Drive sim_node (real_time_factor 0) and controller_node on a circle; return figures.
+
+    Keys: ``rtf`` (sim per wall time), ``yaw`` (min, max) [rad/s] and ``sign_changes`` of the
+    yaw rate (each beyond 0.05 rad/s), ``radius`` (median of v / omega over samples moving
+    at 0.2 m/s or more) [m], ``followed`` (one-second windows within 10 % of the commanded v
+    and omega, of all), ``swivel`` (largest |angle|) and ``limit`` [rad]; after
+    ``CIRCLE_SETTLE``.
+    """
+    sim_exe = _executable('swivel_car_sim', 'sim_node')
+    controller_exe = _executable('swivel_car_control', 'controller_node')
+    if sim_exe is None or controller_exe is None:
+        return None
+    processes = [subprocess.Popen(
+        [sim_exe, '--ros-args', '-p', 'real_time_factor:=0.0', '-p', 'start_paused:=true',
+         '-p', f'max_command_age:={max_command_age}'], env=_environment(DOMAIN),
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL), subprocess.Popen(
+        [controller_exe, '--ros-args', '-p', 'use_sim_time:=true'], env=_environment(DOMAIN),
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=DOMAIN)
+    node = Node('benchmark_driver', context=context, parameter_overrides=[
+        rclpy.parameter.Parameter('use_sim_time', value=True)])
+    truth: list[bytes] = []
+    states: list[bytes] = []
+    node.create_subscription(Odometry, 'ground_truth/odom', truth.append, 100_000, raw=True)
+    node.create_subscription(JointState, 'joint_states', states.append, 100_000, raw=True)
+    cmd_vel = node.create_publisher(TwistStamped, 'cmd_vel', 10)
+
+    def drive() -> None:
+        msg = TwistStamped()
+        msg.header.stamp = node.get_clock().now().to_msg()
+        msg.twist.linear.x, msg.twist.angular.z = CIRCLE
+        cmd_vel.publish(msg)
+    node.create_timer(0.02, drive, clock=rclpy.clock.Clock(
+        clock_type=rclpy.clock.ClockType.STEADY_TIME))
+    pause = node.create_client(SetBool, 'sim/set_paused')
+    executor = EventsExecutor(context=context)
+    executor.add_node(node)
+    try:
+        deadline = time.perf_counter() + 60.0  # a guard against a hang
+        while not (pause.service_is_ready() and node.count_subscribers('cmd_vel')
+                   and node.count_subscribers('joint_states') >= 2
+                   and node.count_publishers('actuator_command')):
+            executor.spin_once(timeout_sec=0.05)
+            if time.perf_counter() > deadline:
+                return None
+        future = pause.call_async(SetBool.Request(data=False))
+        start = time.perf_counter()
+        end_ns = round(sim_seconds * 1e9)
+        while (not truth or _stamp_ns(deserialize_message(truth[-1], Odometry)) < end_ns) \
+                and time.perf_counter() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+        wall = time.perf_counter() - start
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+        for process in processes:
+            process.send_signal(signal.SIGINT)
+            process.wait(10)
+    if not future.done():
+        return None
+    settle_ns = round(CIRCLE_SETTLE * 1e9)
+    samples = []  # (stamp [ns], v [m/s], omega [rad/s])
+    for data in truth:
+        msg = deserialize_message(data, Odometry)
+        if _stamp_ns(msg) > settle_ns:
+            samples.append((_stamp_ns(msg), msg.twist.twist.linear.x, msg.twist.twist.angular.z))
+    swivel = max(abs(deserialize_message(data, JointState).position[0]) for data in states)
+    yaw = [w for _, _, w in samples]
+    signs = [w > 0.0 for w in yaw if abs(w) > 0.05]
+    radii = sorted(v / w for _, v, w in samples if v >= 0.2 and w != 0.0)
+    windows: dict[int, list[tuple[float, float]]] = {}
+    for stamp, v, w in samples:
+        windows.setdefault((stamp - settle_ns) // 1_000_000_000, []).append((v, w))
+    followed = sum(
+        abs(sum(v for v, _ in vw) / len(vw) - CIRCLE[0]) <= 0.1 * CIRCLE[0]
+        and abs(sum(w for _, w in vw) / len(vw) - CIRCLE[1]) <= 0.1 * CIRCLE[1]
+        for vw in windows.values())
+    return {'rtf': (samples[-1][0] * 1e-9 if samples else 0.0) / wall,
+            'yaw': (min(yaw), max(yaw)), 'sign_changes': sum(
+                a != b for a, b in zip(signs, signs[1:])),
+            'radius': radii[len(radii) // 2] if radii else math.inf,
+            'followed': (followed, len(windows)), 'swivel': swivel,
+            'limit': PARAMETERS['max_swivel_angle'][0]}
+
+
+def _stamp_ns(msg) -> int:
+    return msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--seconds', type=float, default=5.0, help='wall time per figure')
+    parser.add_argument('--circle-seconds', type=float, default=20.0,
+                        help='sim time of each closed-loop circle (5)')
+    parser.add_argument('--circle-only', action='store_true', help='only the figures of (5)')
     parser.add_argument('--listen', type=int, metavar='DOMAIN', help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.listen is not None:
         _listen(args.listen)
         return
-    raw = raw_pybullet_rtf(args.seconds)
-    core = core_rtf(args.seconds)
-    alone = node_rtf(args.seconds, listener=False)
-    node = node_rtf(args.seconds, listener=True)
-    process = process_rtf(args.seconds)
+    if not args.circle_only:
+        _speed(args.seconds)
+    default_age = PARAMETERS['max_command_age'][0]
+    for age in (default_age, 0.5):
+        c = closed_loop_circle(args.circle_seconds, age)
+        if c is None:
+            print('closed loop: sim_node or controller_node not installed, or not up in 60 s')
+            continue
+        print(f'sim_node (real_time_factor 0, max_command_age {age} s) + controller_node, '
+              f'cmd_vel {CIRCLE[0]} m/s, {CIRCLE[1]} rad/s at 50 Hz wall, from '
+              f'{CIRCLE_SETTLE} s: {c["rtf"]:.1f}x real time; yaw rate {c["yaw"][0]:+.2f} to '
+              f'{c["yaw"][1]:+.2f} rad/s, {c["sign_changes"]} sign changes; radius '
+              f'{c["radius"]:.2f} m (commanded {CIRCLE[0] / CIRCLE[1]:.2f}); '
+              f'{c["followed"][0]} of {c["followed"][1]} one-second windows within 10 %; '
+              f'swivel at most {c["swivel"]:.4f} rad, limit {c["limit"]:.4f}: '
+              f'{"never past" if c["swivel"] <= c["limit"] + STOP_SLACK else "PAST"}')
+
+
+def _speed(seconds: float) -> None:
+    """Print figures (1) to (4)."""
+    raw = raw_pybullet_rtf(seconds)
+    core = core_rtf(seconds)
+    alone = node_rtf(seconds, listener=False)
+    node = node_rtf(seconds, listener=True)
+    process = process_rtf(seconds)
     print(f'load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; real-time factor '
           'per wall second and per CPU second of this process; overhead = extra CPU per sim '
           'second over raw stepping')
