@@ -110,10 +110,10 @@ bench: build
 	$(IN_WS) python -m swivel_car_perception.benchmark
 	$(IN_WS) python scripts/chain_benchmark.py
 	$(IN_WS) python -m swivel_car_control.benchmark
-	$(IN_WS) python -m swivel_car_bringup.benchmark
-	$(IN_WS) python -m swivel_car_bringup.campaign_benchmark
-	$(IN_WS) python -m swivel_car_bringup.climb_benchmark $(CLIMB_BENCH_ARGS)
-	$(IN_WS) python -m swivel_car_bringup.detected_climb_benchmark
+	$(IN_WS) python -m swivel_car_studies.benchmark
+	$(IN_WS) python -m swivel_car_studies.campaign_benchmark
+	$(IN_WS) python -m swivel_car_studies.climb_benchmark $(CLIMB_BENCH_ARGS)
+	$(IN_WS) python -m swivel_car_studies.detected_climb_benchmark
 
 # Ten minutes of driving and climbs through the ROS stack: memory slope and message rates.
 soak: build

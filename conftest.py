@@ -21,9 +21,9 @@ import os
 from hypothesis import settings
 import pytest
 
-for package in ('swivel_car_bringup', 'swivel_car_control', 'swivel_car_model',
-                'swivel_car_perception', 'swivel_car_planner', 'swivel_car_ros',
-                'swivel_car_sim'):
+for package in ('swivel_car_control', 'swivel_car_model', 'swivel_car_perception',
+                'swivel_car_planner', 'swivel_car_ros', 'swivel_car_sim', 'swivel_car_studies',
+                'swivel_car_telemetry'):
     importlib.import_module(package)
 
 settings.register_profile('deterministic', derandomize=True, deadline=None)

@@ -165,10 +165,10 @@ def run_demo(args: argparse.Namespace, progress: Progress) -> tuple[dict, Record
     shutil.rmtree(args.report / 'bag', ignore_errors=True)
     sim_time = args.clock == 'sim'
     parameters = NODE_PARAMETERS if sim_time else WALL_PARAMETERS
-    processes = [NodeProcess('swivel_car_bringup', 'recorder_node', domain_id, {
+    processes = [NodeProcess('swivel_car_telemetry', 'recorder_node', domain_id, {
         'use_sim_time': sim_time, 'output': str(args.report / 'bag'),
         'discovery_period': 0.2}),
-                 NodeProcess('swivel_car_bringup', 'robot_description_node', domain_id,
+                 NodeProcess('swivel_car_telemetry', 'robot_description_node', domain_id,
                              {'use_sim_time': sim_time})]
     processes += [start_node(package, executable, domain_id, parameters[executable])
                   for package, executable in NODES]

@@ -42,9 +42,9 @@ plt.ylabel('swivel angle [rad]')
 plt.savefig('swivel_angle.png')
 print(f'{len(t)} joint_states plotted to swivel_angle.png')
 """
-# Shipped with swivel_car_bringup: 3D view following base_link, the swivel angle, pitch and
+# Shipped with swivel_car_telemetry: 3D view following base_link, the swivel angle, pitch and
 # torque, and the climb's feedback.
-FOXGLOVE_LAYOUT = 'swivel_car_bringup/config/foxglove_layout.json'
+FOXGLOVE_LAYOUT = 'swivel_car_telemetry/config/foxglove_layout.json'
 
 
 @dataclass

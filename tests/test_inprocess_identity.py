@@ -1,5 +1,5 @@
 """
-The in-process stack (swivel_car_bringup.inprocess) is the ROS lockstep run, bit for bit.
+The in-process stack (swivel_car_studies.inprocess) is the ROS lockstep run, bit for bit.
 
 One climb through the installed executables and through InProcessStack gives the same outcome
 and the same ground truth, joint positions and actuator commands in every control period.
@@ -35,13 +35,13 @@ from rclpy.serialization import deserialize_message
 from sensor_msgs.msg import JointState
 from sim_session import SimSession
 from std_srvs.srv import Empty
-from swivel_car_bringup.inprocess import InProcessStack, StackConfig
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand
 from swivel_car_msgs.srv import ClimbStep, StepSimulation
 from swivel_car_planner.core import ClimbRequest, ErrorCode
 from swivel_car_ros.serialized import read_header
 from swivel_car_sim.config import SimNodeConfig
 from swivel_car_sim.sim_node import LOCKSTEP_TIMED_OUT_LOG
+from swivel_car_studies.inprocess import InProcessStack, StackConfig
 
 HEIGHT = 0.04  # [m]
 DISTANCE = 1.0  # [m] front axle to the edge; nearer, the planner has no room to align

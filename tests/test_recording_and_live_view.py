@@ -85,8 +85,8 @@ def test_a_recorded_run_reads_back_with_an_independent_reader(ros_domain, tmp_pa
     bag = tmp_path / 'run'
     stack = _start(domain_id, ('swivel_car_sim', 'sim_node', {'start_paused': True}),
                    ('swivel_car_control', 'odometry_node', {}),
-                   ('swivel_car_bringup', 'robot_description_node', {}))
-    recorder = _start(domain_id, ('swivel_car_bringup', 'recorder_node',
+                   ('swivel_car_telemetry', 'robot_description_node', {}))
+    recorder = _start(domain_id, ('swivel_car_telemetry', 'recorder_node',
                                   {'output': str(bag), 'discovery_period': 0.2}))[0]
     probe = Probe(context)
     executor = EventsExecutor(context=context)
@@ -167,7 +167,7 @@ def test_a_recorded_run_reads_back_with_an_independent_reader(ros_domain, tmp_pa
 def test_robot_description_for_a_late_subscriber_matches_joint_states(ros_domain):
     domain_id, context = ros_domain
     stack = _start(domain_id, ('swivel_car_sim', 'sim_node', {}),
-                   ('swivel_car_bringup', 'robot_description_node', {}))
+                   ('swivel_car_telemetry', 'robot_description_node', {}))
     probe = Probe(context)
     executor = EventsExecutor(context=context)
     executor.add_node(probe)
@@ -243,8 +243,8 @@ def test_the_live_view_serves_decodable_joint_states_odom_and_tf(ros_domain):
     port = _free_port()
     stack = _start(domain_id, ('swivel_car_sim', 'sim_node', {}),
                    ('swivel_car_control', 'odometry_node', {}),
-                   ('swivel_car_bringup', 'robot_description_node', {}),
-                   ('swivel_car_bringup', 'foxglove_bridge_node', {'port': port}))
+                   ('swivel_car_telemetry', 'robot_description_node', {}),
+                   ('swivel_car_telemetry', 'foxglove_bridge_node', {'port': port}))
     try:
         decoded = asyncio.run(_foxglove_messages(
             port, {'/joint_states', '/odom', '/robot_description', '/tf', '/tf_static'},
@@ -266,7 +266,7 @@ def test_the_live_view_serves_decodable_joint_states_odom_and_tf(ros_domain):
 
 def test_a_bad_output_is_one_fatal_line(ros_domain, tmp_path):
     domain_id, _ = ros_domain
-    recorder = NodeProcess('swivel_car_bringup', 'recorder_node', domain_id,
+    recorder = NodeProcess('swivel_car_telemetry', 'recorder_node', domain_id,
                            {'output': str(tmp_path)})
     recorder.process.wait(60)
     output = recorder.output()
@@ -283,7 +283,7 @@ _FULL_DISK = textwrap.dedent("""
     from pathlib import Path
     from ament_index_python.packages import get_package_share_directory
     from mcap.reader import make_reader
-    from swivel_car_bringup.bag import BagWriter, MessageDefinitions
+    from swivel_car_telemetry.bag import BagWriter, MessageDefinitions
     disk = Path(sys.argv[1])
     bag = BagWriter(disk / 'bag', MessageDefinitions(get_package_share_directory), 1_500_000)
     bag.create()

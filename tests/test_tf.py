@@ -32,11 +32,11 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosbags.typesys import get_typestore, Stores
 from scipy.spatial.transform import Rotation
 from sensor_msgs.msg import JointState
-from swivel_car_bringup.bag import MessageDefinitions
-from swivel_car_bringup.robot_description_node import RobotDescriptionNode
-from swivel_car_bringup.topics import message_class
 from swivel_car_msgs.srv import StepSimulation
 from swivel_car_sim.sim_node import SimNode
+from swivel_car_telemetry.bag import MessageDefinitions
+from swivel_car_telemetry.robot_description_node import RobotDescriptionNode
+from swivel_car_telemetry.topics import message_class
 from swivel_car_testing import next_domain_id, NodeProcess, REPO_ROOT, spin_until, start_node
 from tf2_msgs.msg import TFMessage
 
@@ -229,9 +229,9 @@ def test_live_tf_and_a_recorded_bag_place_every_link(ros_domain, tmp_path):
     stack = [start_node('swivel_car_sim', 'sim_node', domain_id,
                         {'use_sim_time': True, 'start_paused': True}),
              start_node('swivel_car_control', 'odometry_node', domain_id, {'use_sim_time': True}),
-             NodeProcess('swivel_car_bringup', 'robot_description_node', domain_id,
+             NodeProcess('swivel_car_telemetry', 'robot_description_node', domain_id,
                          {'use_sim_time': True}),
-             NodeProcess('swivel_car_bringup', 'recorder_node', domain_id,
+             NodeProcess('swivel_car_telemetry', 'recorder_node', domain_id,
                          {'use_sim_time': True, 'output': str(bag), 'discovery_period': 0.2})]
     probe = _Probe(context)
     executor = EventsExecutor(context=context)

@@ -62,15 +62,15 @@ def generate_launch_description() -> LaunchDescription:
         _include('swivel_car_control', 'control.launch.py', sim_time_argument),
         _include('swivel_car_planner', 'planner.launch.py', sim_time_argument),
         _include('swivel_car_perception', 'perception.launch.py', sim_time_argument),
-        Node(package='swivel_car_bringup', executable='robot_description_node',
+        Node(package='swivel_car_telemetry', executable='robot_description_node',
              name='robot_description', output='screen',
              parameters=[{**use_sim_time, 'robot_variant': ParameterValue(
                  LaunchConfiguration('robot_variant'), value_type=str)}]),
-        Node(package='swivel_car_bringup', executable='recorder_node', name='recorder',
+        Node(package='swivel_car_telemetry', executable='recorder_node', name='recorder',
              output='screen', condition=IfCondition(LaunchConfiguration('record')),
              parameters=[{**use_sim_time, 'output': ParameterValue(
                  LaunchConfiguration('bag'), value_type=str)}]),
-        Node(package='swivel_car_bringup', executable='foxglove_bridge_node',
+        Node(package='swivel_car_telemetry', executable='foxglove_bridge_node',
              name='foxglove_bridge', output='screen',
              condition=IfCondition(LaunchConfiguration('foxglove')),
              parameters=[{**use_sim_time, 'port': ParameterValue(

@@ -2,7 +2,7 @@
 Judging a climb by the sim's ground truth, ROS-free.
 
 Shared by the system tests (from ``ground_truth/odom``) and the in-process stack
-(``swivel_car_bringup.inprocess``, from the sim core's state).
+(``swivel_car_studies.inprocess``, from the sim core's state).
 """
 
 from __future__ import annotations

@@ -249,7 +249,7 @@ class PlannerNode(Node):
             self.get_logger().warning(
                 f'the capability table {path} was measured on another robot description; '
                 'its limit may not hold for this one (regenerate it: python -m '
-                'swivel_car_bringup.climb_benchmark --write-capability)')
+                'swivel_car_studies.climb_benchmark --write-capability)')
         bound = ('' if table.confidence is None
                  else f'lower {table.confidence:.0%} confidence bound on ')
         self.get_logger().info(f'whole-car limit {table.limit:.3f} m ({bound}success >= '

@@ -2,7 +2,7 @@
 What the controller and odometry nodes do with one ``joint_states`` message, ROS-free.
 
 The nodes call these on the message's fields (stamp in seconds, names, positions,
-velocities); the in-process stack (``swivel_car_bringup.inprocess``) calls them on the sim
+velocities); the in-process stack (``swivel_car_studies.inprocess``) calls them on the sim
 core's state, so both run the same code on the same floats.
 """
 

@@ -4,7 +4,7 @@ What the whole car climbs, as measured in physics: the planner's capability tabl
 The model says how high the *front* wheels can be lifted (thesis eq. 68 and the tip-over rule);
 whether the rear axle follows depends on mass layout, drive train, friction and speed, which
 the kinematics leave out. So the planner's whole-car limit is a measurement: the climbing
-benchmark (``python -m swivel_car_bringup.climb_benchmark --write-capability``) climbs randomised
+benchmark (``python -m swivel_car_studies.climb_benchmark --write-capability``) climbs randomised
 steps in the real sim and writes this table; the planner refuses steps above the highest
 height that succeeded reliably, and says so.
 

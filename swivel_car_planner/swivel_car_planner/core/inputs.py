@@ -5,7 +5,7 @@ What the node takes from each message, and the ``Observation`` one synchronised 
 (``core.sync.Tick``) makes.
 
 The planner node calls these on its messages' fields and the in-process stack
-(``swivel_car_bringup.inprocess``) on the cores' outputs, so both hand the state machine the
+(``swivel_car_studies.inprocess``) on the cores' outputs, so both hand the state machine the
 same floats. A non-finite field is refused here, where it enters (a ValueError naming the
 message's field): one NaN in an observation would reach a command.
 """

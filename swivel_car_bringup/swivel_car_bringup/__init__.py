@@ -1,1 +1,0 @@
-"""The swivel car stack in one process, without ROS (see ``inprocess``)."""
