@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import struct
-
 from builtin_interfaces.msg import Time
-from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan as ClimbPlanMsg
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import Imu
+from swivel_car_msgs.msg import ClimbOutcome, ClimbPlan as ClimbPlanMsg, SwivelControllerState
 
 from swivel_car_planner.core import ClimbPlan, ClimbRequest, Outcome
-from swivel_car_ros.serialized import aligned, CDR_START, read_header
+from swivel_car_ros.serialized import MessageReader
 
 
 def request_from(message, with_time_allowance: bool) -> ClimbRequest:
@@ -42,6 +42,13 @@ def outcome_to_msg(outcome: Outcome) -> ClimbOutcome:
 # The planner reads its inputs serialized (swivel_car_ros.serialized): deserialising a whole
 # nav_msgs/Odometry (two 6x6 covariances) took 134 us and an Imu 45 us of a 10 ms control
 # period on this machine; the few fields it uses are read at their CDR offsets here.
+_STAMP = ('header.stamp.sec', 'header.stamp.nanosec')
+_ODOM = MessageReader(Odometry, _STAMP + tuple(f'pose.pose.position.{c}' for c in 'xy') + tuple(
+    f'pose.pose.orientation.{c}' for c in 'xyzw') + ('twist.twist.linear.x',))
+_CONTROLLER_STATE = MessageReader(SwivelControllerState, _STAMP + (
+    'set_point', 'measured', 'measured_rate', 'torque', 'swivel_command_stamp.sec',
+    'swivel_command_stamp.nanosec'))
+_IMU = MessageReader(Imu, _STAMP + tuple(f'orientation.{c}' for c in 'xyzw'))
 
 
 def odom_fields(data: bytes) -> tuple[Time, float, float, tuple[float, float, float, float],
@@ -52,14 +59,8 @@ def odom_fields(data: bytes) -> tuple[Time, float, float, tuple[float, float, fl
     Returns stamp, position x, y [m], orientation quaternion (x, y, z, w) and forward speed
     (twist.linear.x) [m/s].
     """
-    stamp, offset = read_header(data)
-    offset = aligned(offset, 4)  # child_frame_id
-    (length,) = struct.unpack_from('<I', data, CDR_START + offset)
-    offset = aligned(offset + 4 + length, 8)  # pose.pose.position
-    x, y, _, *orientation = struct.unpack_from('<7d', data, CDR_START + offset)
-    # After the pose (7 doubles) and its covariance (36): twist.twist.linear.x.
-    (speed,) = struct.unpack_from('<d', data, CDR_START + offset + 8 * (7 + 36))
-    return stamp, x, y, tuple(orientation), speed
+    sec, nanosec, x, y, *orientation, speed = _ODOM(data)
+    return Time(sec=sec, nanosec=nanosec), x, y, tuple(orientation), speed
 
 
 def controller_state_fields(data: bytes) -> tuple[Time, float, float, float, float, Time]:
@@ -69,19 +70,13 @@ def controller_state_fields(data: bytes) -> tuple[Time, float, float, float, flo
     Returns stamp, set point [rad], measured swivel angle [rad] and rate [rad/s], torque [N m]
     and the stamp of the last swivel_command the controller heard (zero: none).
     """
-    stamp, offset = read_header(data)
-    offset = aligned(offset, 8)  # set_point, target, measured, measured_rate, error, torque
-    set_point, _, measured, measured_rate, _, torque = struct.unpack_from(
-        '<6d', data, CDR_START + offset)
-    offset = aligned(offset + 8 * 9 + 1, 8)  # 9 float64 to d_term, bool saturated
-    (length,) = struct.unpack_from('<I', data, CDR_START + offset + 8)  # source, after drive_speed
-    offset = aligned(offset + 8 + 4 + length, 4)
-    sec, nanosec = struct.unpack_from('<iI', data, CDR_START + offset)
-    return stamp, set_point, measured, measured_rate, torque, Time(sec=sec, nanosec=nanosec)
+    sec, nanosec, set_point, measured, measured_rate, torque, heard_sec, heard_nanosec = (
+        _CONTROLLER_STATE(data))
+    return (Time(sec=sec, nanosec=nanosec), set_point, measured, measured_rate, torque,
+            Time(sec=heard_sec, nanosec=heard_nanosec))
 
 
 def imu_fields(data: bytes) -> tuple[Time, tuple[float, float, float, float]]:
     """Read a serialized sensor_msgs/Imu: its stamp and orientation quaternion (x, y, z, w)."""
-    stamp, offset = read_header(data)
-    orientation = struct.unpack_from('<4d', data, CDR_START + aligned(offset, 8))
-    return stamp, orientation
+    sec, nanosec, *orientation = _IMU(data)
+    return Time(sec=sec, nanosec=nanosec), tuple(orientation)

@@ -11,17 +11,21 @@ are subscribed with ``raw=True`` and read here, or serialized once and rewritten
 The bytes are little-endian CDR (XCDR1, as rmw_fastrtps and rmw_cyclonedds send ROS types from
 x86 and ARM machines): a 4-byte encapsulation header, then each primitive aligned to its size
 from the end of that header; a string is a uint32 length (with its NUL) and its bytes, a
-sequence a uint32 count and its elements.
+sequence a uint32 count and its elements. ``MessageReader`` lays a message type's fields out
+from its definition (the ``.msg`` as rosidl generated it), so a reader follows the message
+when a field is added.
 """
 
 from __future__ import annotations
 
 from functools import reduce
+import importlib
 import struct
 from typing import Callable, NamedTuple, TypeVar
 
 from builtin_interfaces.msg import Time
 from rclpy.serialization import serialize_message
+from sensor_msgs.msg import JointState
 
 CDR_LITTLE_ENDIAN = b'\x00\x01'
 CDR_START = 4  # [B] the encapsulation header
@@ -31,11 +35,6 @@ STAMP_FORMAT = '<iI'
 _UINT32 = struct.Struct('<I')
 
 T = TypeVar('T')
-
-
-def aligned(offset: int, size: int) -> int:
-    """Return ``offset`` [B] (from the end of the encapsulation header) aligned to ``size``."""
-    return offset + (-offset) % size
 
 
 def read_header(data: bytes) -> tuple[Time, int]:
@@ -71,6 +70,193 @@ def read_logged(logger, read: Callable[[bytes], T], data: bytes, topic: str) -> 
         return None
 
 
+# CDR primitives as struct format characters (rosidl's type names).
+_PRIMITIVES = {'boolean': '?', 'octet': 'B', 'char': 'B', 'uint8': 'B', 'int8': 'b',
+               'uint16': 'H', 'int16': 'h', 'uint32': 'I', 'int32': 'i', 'uint64': 'Q',
+               'int64': 'q', 'float': 'f', 'double': 'd'}
+
+
+def _element(kind: str) -> str:
+    """Return the struct character of a primitive, 's' for a string (bounded or not)."""
+    if kind == 'string' or kind.startswith('string<'):
+        return 's'
+    if kind in _PRIMITIVES:
+        return _PRIMITIVES[kind]
+    raise ValueError(f'{kind} is not a primitive or a string')
+
+
+def _leaves(message_type, prefix: str = ''):
+    """
+    Yield the fields of ``message_type`` in serialized order, nested messages flattened.
+
+    Each is (dotted path, kind, struct character, count): kind 'fixed' (a primitive,
+    ``count`` of them for a fixed array), 'string' or 'sequence' (of primitives or strings).
+    """
+    for name, kind in message_type.get_fields_and_field_types().items():
+        path = prefix + name
+        if kind.startswith('sequence<'):
+            yield path, 'sequence', _element(kind[9:-1].split(',')[0]), 0
+        elif '/' in kind and '[' not in kind:
+            package, _, type_name = kind.partition('/')
+            nested = getattr(importlib.import_module(f'{package}.msg'), type_name)
+            yield from _leaves(nested, path + '.')
+        elif kind.endswith(']') and kind[:kind.index('[')] in _PRIMITIVES:
+            base, _, count = kind[:-1].partition('[')
+            yield path, 'fixed', _PRIMITIVES[base], int(count)
+        else:
+            character = _element(kind)
+            yield path, 'string' if character == 's' else 'fixed', character, 1
+
+
+def _fixed_run(run: list, wanted: set):
+    """
+    Return a reader of consecutive primitives, the first the most aligned of them.
+
+    Aligned at the first, the padding inside the run is fixed: one struct does it all.
+    """
+    size = struct.calcsize(run[0][2])
+    layout, position = '<', 0
+    for path, _, character, count in run:
+        item = struct.calcsize(character)
+        padding = (-position) % item
+        if path in wanted and count != 1:
+            raise ValueError(f'{path} is an array: read its elements from the messages')
+        layout += f'{padding}x' + (character if path in wanted else f'{item * count}x')
+        position += padding + item * count
+    unpack, length = struct.Struct(layout).unpack_from, struct.calcsize(layout)
+
+    def read(data, at: int, out: list) -> int:
+        at += (CDR_START - at) % size
+        out += unpack(data, at)
+        return at + length
+
+    def skip(data, at: int, out: list) -> int:
+        return at + (CDR_START - at) % size + length
+    return read if wanted.intersection(path for path, *_ in run) else skip
+
+
+def _unpack_string(data, at: int) -> tuple[str, int]:
+    at += (CDR_START - at) % 4
+    (length,) = _UINT32.unpack_from(data, at)  # with its NUL
+    return bytes(data[at + 4:at + 3 + length]).decode(), at + 4 + length
+
+
+def _skip_string(data, at: int, out: list) -> int:
+    at += (CDR_START - at) % 4
+    return at + 4 + _UINT32.unpack_from(data, at)[0]
+
+
+def _variable(character: str, kind: str, keep: bool):
+    """Return a reader of a string or a sequence, that keeps its value if ``keep``."""
+    def string(data, at: int, out: list) -> int:
+        text, at = _unpack_string(data, at)
+        if keep:
+            out.append(text)
+        return at
+
+    def strings(data, at: int, out: list) -> int:
+        at += (CDR_START - at) % 4
+        (count,) = _UINT32.unpack_from(data, at)
+        at += 4
+        texts = []
+        for _ in range(count):
+            text, at = _unpack_string(data, at)
+            texts.append(text)
+        if keep:
+            out.append(tuple(texts))
+        return at
+
+    def primitives(data, at: int, out: list) -> int:
+        at += (CDR_START - at) % 4
+        (count,) = _UINT32.unpack_from(data, at)
+        at += 4
+        if count:  # Fast CDR aligns the elements, not the count: none, no padding
+            at += (CDR_START - at) % size
+        if keep:
+            out.append(struct.unpack_from(f'<{count}{character}', data, at))
+        return at + size * count
+    if kind == 'string':
+        return string if keep else _skip_string
+    if character == 's':
+        return strings
+    size = struct.calcsize(character)
+    return primitives
+
+
+class MessageReader:
+    """
+    Read chosen fields of a serialized message at offsets laid out from its definition.
+
+    Parameters
+    ----------
+    message_type
+        A rosidl message class; its ``get_fields_and_field_types`` (the ``.msg``) gives the
+        order and types of the fields, nested messages included.
+    paths : tuple of str
+        The fields to read, as dotted paths ('header.stamp.sec', 'pose.pose.position.x'): a
+        primitive, a string or a sequence (read as a tuple), in the order of the message.
+        Called with the bytes, the reader returns their values.
+
+    Raises
+    ------
+    ValueError
+        A path that is not a primitive, string or sequence field of the message, paths out of
+        order, or a field of a type laid out otherwise (an array or a sequence of messages).
+
+    """
+
+    def __init__(self, message_type, paths: tuple[str, ...]) -> None:
+        self._name = message_type.__name__
+        leaves = list(_leaves_until(message_type, set(paths)))
+        if [path for path, *_ in leaves if path in paths] != list(paths):
+            raise ValueError(f'{self._name}: give the paths in the order of its fields')
+        wanted, self._readers, run = set(paths), [], []
+        for leaf in leaves:
+            if leaf[1] == 'fixed' and run and struct.calcsize(leaf[2]) <= struct.calcsize(
+                    run[0][2]):
+                run.append(leaf)
+                continue
+            if run:
+                self._readers.append(_fixed_run(run, wanted))
+            run = [leaf] if leaf[1] == 'fixed' else []
+            if not run:
+                self._readers.append(_variable(leaf[2], leaf[1], leaf[0] in wanted))
+        if run:
+            self._readers.append(_fixed_run(run, wanted))
+
+    def __call__(self, data: bytes) -> tuple:
+        """
+        Return the fields' values.
+
+        Raises
+        ------
+        ValueError
+            Not little-endian plain CDR, or shorter than its fields or counts say.
+
+        """
+        if data[:2] != CDR_LITTLE_ENDIAN:
+            raise ValueError(
+                f'not little-endian plain CDR: encapsulation {bytes(data[:2]).hex()}')
+        out, at = [], CDR_START
+        try:
+            for read in self._readers:
+                at = read(data, at, out)
+        except (struct.error, UnicodeDecodeError) as error:
+            raise ValueError(f'malformed {self._name}: {error}') from None
+        return tuple(out)
+
+
+def _leaves_until(message_type, paths: set[str]):
+    """Yield the leaves of ``message_type`` up to the last of ``paths``; raise on unknown."""
+    leaves = list(_leaves(message_type))
+    known = {path for path, *_ in leaves}
+    if not paths <= known:
+        raise ValueError(f'{message_type.__name__} has no field(s) '
+                         f'{", ".join(sorted(paths - known))}')
+    last = max(index for index, (path, *_) in enumerate(leaves) if path in paths)
+    return leaves[:last + 1]
+
+
 class JointStateView(NamedTuple):
     """The fields of a sensor_msgs/JointState a controller or an odometry reads."""
 
@@ -78,6 +264,10 @@ class JointStateView(NamedTuple):
     name: tuple[str, ...]
     position: tuple[float, ...]  # [rad] or [m]
     velocity: tuple[float, ...]  # [rad/s] or [m/s]; may be empty
+
+
+_JOINT_STATE = MessageReader(
+    JointState, ('header.stamp.sec', 'header.stamp.nanosec', 'name', 'position', 'velocity'))
 
 
 def read_joint_state(data: bytes) -> JointStateView:
@@ -90,29 +280,8 @@ def read_joint_state(data: bytes) -> JointStateView:
         Not little-endian plain CDR, or shorter than its counts say.
 
     """
-    stamp, offset = read_header(data)
-    unpack_count = _UINT32.unpack_from
-    # Offsets from the start of the data: CDR aligns from the end of the encapsulation header.
-    at = CDR_START + aligned(offset, 4)
-    try:
-        (count,) = unpack_count(data, at)
-        at += 4
-        names = []
-        for _ in range(count):
-            (length,) = unpack_count(data, at)
-            names.append(data[at + 4:at + 3 + length].decode())
-            at += 4 + length + (-length) % 4
-        arrays = []
-        for _ in range(2):  # position, velocity
-            (count,) = unpack_count(data, at)
-            at += 4
-            if count:  # Fast CDR aligns the elements, not the count: none, no padding
-                at += (CDR_START - at) % 8
-            arrays.append(struct.unpack_from(f'<{count}d', data, at))
-            at += 8 * count
-    except (struct.error, UnicodeDecodeError) as error:
-        raise ValueError(f'malformed JointState: {error}') from None
-    return JointStateView(stamp, tuple(names), *arrays)
+    sec, nanosec, *arrays = _JOINT_STATE(data)
+    return JointStateView(Time(sec=sec, nanosec=nanosec), *arrays)
 
 
 def _field(parent, name: str):

@@ -1,13 +1,18 @@
 """CDR bytes read and rewritten in place against rclpy's own serialization."""
 
+from functools import reduce
+from itertools import count
+
 from hypothesis import given, settings, strategies as st
 from nav_msgs.msg import Odometry
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import Imu, JointState
+import swivel_car_msgs.msg
 from swivel_car_msgs.msg import ActuatorCommand
 from swivel_car_ros.serialized import (
-    read_header, read_joint_state, read_logged, SerializedMessage, STAMP_FORMAT)
+    MessageReader, read_header, read_joint_state, read_logged, SerializedMessage,
+    STAMP_FORMAT)
 
 _NAMES = st.text(st.characters(codec='utf-8', exclude_characters='\x00'), max_size=9)
 _VALUES = st.lists(st.floats(allow_nan=False), max_size=6)
@@ -75,3 +80,67 @@ def test_fields_apart_in_the_serialized_message_are_refused():
     with pytest.raises(ValueError, match='not consecutive'):
         SerializedMessage(Odometry(), (('<2d', ('pose.pose.position.x',
                                                 'twist.twist.linear.x')),))
+
+
+def _filled(msg, numbers, prefix=''):
+    """
+    Set every field of ``msg`` to a value of its own; return the paths a reader can read.
+
+    Strings and sequences of every length modulo 8 (by ``numbers``' start) put the fields
+    after them at every alignment.
+    """
+    paths = []
+    for name, kind in msg.get_fields_and_field_types().items():
+        value, n = getattr(msg, name), next(numbers)
+        if hasattr(value, 'get_fields_and_field_types'):
+            paths += _filled(value, numbers, f'{prefix}{name}.')
+            continue
+        element = kind.removeprefix('sequence<').partition('[')[0].split(',')[0].rstrip('>')
+        if element.startswith('string'):
+            item = 'abcdefgh'[:n % 8]
+        elif element == 'boolean':
+            item = True
+        elif element in ('float', 'double'):
+            item = n + 0.25
+        else:
+            item = n % 100
+        if kind.startswith('sequence<'):
+            item = [item] * (n % 4)
+        elif kind.endswith(']'):
+            setattr(msg, name, [item] * len(value))
+            continue  # an array: a reader reads its elements from a message of them
+        setattr(msg, name, item)
+        paths.append(prefix + name)
+    return paths
+
+
+_MESSAGES = [getattr(swivel_car_msgs.msg, name) for name in dir(swivel_car_msgs.msg)
+             if hasattr(getattr(swivel_car_msgs.msg, name), 'get_fields_and_field_types')]
+
+
+@pytest.mark.parametrize('message_type', _MESSAGES + [Odometry, Imu, JointState],
+                         ids=lambda message_type: message_type.__name__)
+@pytest.mark.parametrize('start', range(8))
+def test_a_reader_reads_every_field_of_the_message_definitions(message_type, start):
+    # Every field, as the .msg defines it now, set and read back: a field added to a .msg
+    # before the ones a reader reads moves them, and a type the reader cannot lay out fails.
+    msg = message_type()
+    paths = _filled(msg, count(start))
+    values = MessageReader(message_type, tuple(paths))(serialize_message(msg))
+    for path, value in zip(paths, values, strict=True):
+        expected = reduce(getattr, path.split('.'), msg)
+        if not isinstance(expected, (bool, int, float, str)):
+            expected = tuple(expected)
+        assert value == expected, path
+
+
+def test_a_reader_refuses_unknown_or_unordered_fields():
+    with pytest.raises(ValueError, match='has no field'):
+        MessageReader(ActuatorCommand, ('swivel_torque', 'brake'))
+    with pytest.raises(ValueError, match='in the order of its fields'):
+        MessageReader(ActuatorCommand, ('drive_speed', 'swivel_torque'))
+    with pytest.raises(ValueError, match='an array'):
+        MessageReader(Imu, ('orientation_covariance',))
+    with pytest.raises(ValueError, match='malformed ActuatorCommand'):
+        MessageReader(ActuatorCommand, ('drive_speed',))(
+            serialize_message(ActuatorCommand())[:20])

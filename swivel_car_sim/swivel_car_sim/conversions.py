@@ -10,15 +10,13 @@ bytes as they are.
 
 from __future__ import annotations
 
-import struct
-
 from builtin_interfaces.msg import Time
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
+from swivel_car_msgs.msg import ActuatorCommand
 from swivel_car_ros.lockstep import stamp_ns
-from swivel_car_ros.serialized import (
-    aligned, CDR_START, read_header, SerializedMessage, STAMP_FORMAT)
+from swivel_car_ros.serialized import MessageReader, SerializedMessage, STAMP_FORMAT
 
 from swivel_car_sim.robot_state import RobotState
 
@@ -34,6 +32,10 @@ def sim_time_msg(steps: int, time_step_ns: int) -> Time:
     return Time(sec=sec, nanosec=nanosec)
 
 
+_ACTUATOR_COMMAND = MessageReader(ActuatorCommand, (
+    'header.stamp.sec', 'header.stamp.nanosec', 'swivel_torque', 'drive_speed'))
+
+
 def actuator_command_fields(data: bytes) -> tuple[int, float, float]:
     """
     Read a serialized swivel_car_msgs/ActuatorCommand.
@@ -46,9 +48,8 @@ def actuator_command_fields(data: bytes) -> tuple[int, float, float]:
         Not little-endian plain CDR.
 
     """
-    stamp, offset = read_header(data)
-    swivel_torque, drive_speed = struct.unpack_from('<2d', data, CDR_START + aligned(offset, 8))
-    return stamp_ns(stamp), swivel_torque, drive_speed
+    sec, nanosec, swivel_torque, drive_speed = _ACTUATOR_COMMAND(data)
+    return stamp_ns(Time(sec=sec, nanosec=nanosec)), swivel_torque, drive_speed
 
 
 class StateMessages:
