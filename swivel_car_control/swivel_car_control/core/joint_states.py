@@ -23,9 +23,11 @@ YAW_RATE_SOURCES = ('swivel', 'rear_wheels')
 # A swivel reading this far past the joint limit (compliance, sensor noise) is clamped to it;
 # further past it, it is a bad reading (the joint has a hard stop there).
 LIMIT_SLACK = 0.05  # [rad]
-# A swivel turning faster than this is a bad reading: the controller commands at most a
-# few rad/s, and the swivel's torque limit cannot spin the front T much faster.
-MAX_SWIVEL_RATE = 30.0  # [rad/s]
+# A swivel turning faster than this is a bad reading. The fastest the joint really turns: the
+# actuator's full torque (30 N m) from stop to stop, 65 rad/s at the second stop in the sim,
+# standing or driving (test_swivel_rate_bound.py); a controller starved of CPU holds a
+# saturated command that long. Twice that, so that only a reading no motion gives is refused.
+MAX_SWIVEL_RATE = 130.0  # [rad/s]
 # Longest gap between two joint_states taken as the same run; a sim at 10 Hz or more never
 # leaves one this long, a fake stamp does.
 MAX_GAP = 1.0  # [s]
