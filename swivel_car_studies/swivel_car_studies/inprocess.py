@@ -1,8 +1,9 @@
 """
 The swivel car stack in one process, without ROS.
 
-The cores the four nodes wrap, wired in the order and on the control period of the ROS
-lockstep chain (docs/architecture.md, "Timing: sim time and lockstep").
+The cores the four nodes wrap, wired in the order (``swivel_car_ros.chain.CHAIN``) and on the
+control period of the ROS lockstep chain (docs/architecture.md, "Timing: sim time and
+lockstep").
 
 One control period of the ROS chain, and of ``InProcessStack``:
 
@@ -49,8 +50,10 @@ from swivel_car_planner.core import (
     make_plan, Outcome, PlanError, PlannerConfig, validate_request)
 from swivel_car_planner.core.sync import InputSync
 from swivel_car_planner.ground_truth import GroundTruth
+from swivel_car_ros.chain import CHAIN, ROS_ONLY
 from swivel_car_sim.config import PARAMETERS as SIM_PARAMETERS, SimNodeConfig
 from swivel_car_sim.physics import SwivelCarSim
+from swivel_car_sim.robot_state import RobotState
 from swivel_car_sim.sensor_models import DelayedCommands, SensorSuite
 from swivel_car_sim.world import StepSpec
 from swivel_car_studies.inprocess_detection import InProcessDetection
@@ -60,12 +63,6 @@ ROBOT_VARIANTS = ('swivel', 'car_like')
 # The joint the controller and the odometry steer by, per robot variant (the car-like
 # baseline steers a turntable joint; SimSession sets the same).
 _STEER_JOINT = {'swivel': 'swivel_joint', 'car_like': 'steering_joint'}
-# Parameters only the ROS side of a node reads: accepted in overrides, without effect here.
-_ROS_ONLY = {'use_sim_time', 'use_stamped', 'lockstep_swivel_command', 'lockstep_wait',
-             'odom_frame_id', 'base_frame_id', 'tf_frame_prefix', 'enable_odom_tf',
-             'pose_covariance_diagonal', 'twist_covariance_diagonal', 'ready_timeout',
-             'gui', 'real_time_factor', 'lockstep', 'lockstep_timeout',
-             'lockstep_real_time_factor', 'start_paused'}
 _CLIMB_SLACK = 1.0  # [s] of sim time past the climb's time allowance before giving up
 
 
@@ -203,7 +200,8 @@ class StackConfig:
         def node_values(package: str, executable: str, node: str,
                         overrides: dict[str, Any], known: set[str]) -> dict[str, Any]:
             installed = installed_parameters(package, executable, node)
-            _check_names(node, overrides, known | set(installed) | _ROS_ONLY)
+            # A ROS-only parameter is accepted, without effect here.
+            _check_names(node, overrides, known | set(installed) | ROS_ONLY[node])
             return {**installed, **{k: v for k, v in robot.items() if k in car_names},
                     **joint, **overrides}
 
@@ -338,6 +336,21 @@ class ClimbResult:
 
 # --- the stack -----------------------------------------------------------------------------
 
+@dataclass
+class _Period:
+    """What one control period's stages hand on: the state of t and the answers to it."""
+
+    t: float  # [s] the state's stamp
+    state: RobotState  # the sim's ground truth
+    positions: list[float]  # [rad] the joints as the nodes hear them
+    velocities: list[float]  # [rad/s]
+    orientation: list[float]  # [1] ground-truth quaternion x, y, z, w
+    measured: list[float]  # [1] the imu's quaternion
+    swivel: Any = None  # the controller's swivel joint reading
+    out: ControlOutput | None = None  # the controller's answer; None: a joint missing
+    odom_due: bool = False  # the odometry publishes this period
+
+
 class InProcessStack:
     """
     The sim, controller, odometry and planner cores in one process, in lockstep.
@@ -391,6 +404,8 @@ class InProcessStack:
         self._rows: list[tuple] = []
         # The depth camera and the step detector, once ``enable_detection`` is called.
         self.detection: InProcessDetection | None = None
+        # One control period: each node's stage, in the chain's order.
+        self._chain = tuple(getattr(self, f'_{name}_stage') for name in CHAIN)
         self._start_nodes()
 
     def _start_nodes(self) -> None:
@@ -515,7 +530,6 @@ class InProcessStack:
         """Run the lockstep chain once (module docstring), from the state of ``time``."""
         t = self.time
         state = self.sim.state()
-        names = state.joint_names
         positions, velocities = state.positions.tolist(), state.velocities.tolist()
         orientation = state.orientation.tolist()
         if self._sensors is not None:
@@ -531,48 +545,58 @@ class InProcessStack:
             measured = sample.orientation.tolist()
         else:
             measured = orientation
+        period = _Period(t, state, positions, velocities, orientation, measured)
+        for stage in self._chain:
+            stage(period)
+        self._periods += 1
 
-        # controller_node: cmd_vel (renewed every period while driving), then the answer.
+    def _controller_stage(self, p: _Period) -> None:
+        """controller_node: cmd_vel (renewed every period while driving), then the answer."""
         if self._cmd_vel is not None:
-            self.controller.core.set_cmd_vel(*self._cmd_vel, t)
+            self.controller.core.set_cmd_vel(*self._cmd_vel, p.t)
         try:
-            swivel, out = self._timed('controller', self.controller.answer, t, names,
-                                      positions, velocities)
+            p.swivel, p.out = self._timed('controller', self.controller.answer, p.t,
+                                          p.state.joint_names, p.positions, p.velocities)
         except MissingJointError:
-            out = None  # the node answers with zero torque and drive
-        self.last_output = out
-        torque, drive = (out.swivel_torque, out.drive_speed) if out is not None else (0.0, 0.0)
+            p.out = None  # the node answers with zero torque and drive
+        self.last_output = p.out
 
-        # odometry_node
+    def _odometry_stage(self, p: _Period) -> None:
+        """odometry_node: integrates the state; publishes when due."""
         try:
-            odom_due = self._timed('odometry', self.odometry.update, t, names, positions,
-                                   velocities)
+            p.odom_due = self._timed('odometry', self.odometry.update, p.t,
+                                     p.state.joint_names, p.positions, p.velocities)
         except ValueError:  # MissingJointError too: not updated, nothing published
-            odom_due = False
+            p.odom_due = False
 
-        # planner_node: its three inputs of t; a tick steps the running climb.
+    def _planner_stage(self, p: _Period) -> None:
+        """planner_node: its three inputs of t; a tick steps the running climb."""
+        t, out = p.t, p.out
         ticks = []
         if self._periods % self.config.sim.imu_every == 0:
-            ticks += self._sync.add(inputs.IMU, t, inputs.imu_values(measured))
-        if odom_due:
+            ticks += self._sync.add(inputs.IMU, t, inputs.imu_values(p.measured))
+        if p.odom_due:
             o = self.odometry.odometry
             ticks += self._sync.add(inputs.ODOM, t, inputs.odom_values(
                 o.x, o.y, yaw_quaternion(o.yaw), o.v))
         if out is not None:
             ticks += self._sync.add(inputs.CONTROLLER_STATE, t, inputs.controller_state_values(
-                out.set_point, out.swivel_torque, self._command_heard, swivel.position,
-                swivel.rate))
+                out.set_point, out.swivel_torque, self._command_heard, p.swivel.position,
+                p.swivel.rate))
         if self.detection is not None:
             o = self.odometry.odometry
-            self.detection.period(self._periods, t, state,
-                                  Pose2D(o.x, o.y, o.yaw) if odom_due else None,
+            self.detection.period(self._periods, t, p.state,
+                                  Pose2D(o.x, o.y, o.yaw) if p.odom_due else None,
                                   self.machine is not None)
         for tick in ticks:
             self._on_tick(tick)
 
-        self._rows.append((t, *state.position.tolist(), *orientation,
+    def _sim_stage(self, p: _Period) -> None:
+        """sim_node: the actuator command of t, one control period of physics."""
+        state, out = p.state, p.out
+        torque, drive = (out.swivel_torque, out.drive_speed) if out is not None else (0.0, 0.0)
+        self._rows.append((p.t, *state.position.tolist(), *p.orientation,
                            *state.positions.tolist(), torque, drive))
-        # sim_node: the actuator command of t, one control period of physics.
         if self._sensors is None:
             self.sim.set_command(torque, drive)
             self._timed('sim', self.sim.step, self._steps_per_period)
@@ -582,7 +606,6 @@ class InProcessStack:
                                     (torque, drive))
             self._timed('sim', self._commands.step, self.sim, self._steps_per_period,
                         self.sim.set_command)
-        self._periods += 1
 
     def _on_tick(self, tick) -> None:
         machine = self.machine
