@@ -48,7 +48,8 @@ _ODOM = MessageReader(Odometry, _STAMP + tuple(f'pose.pose.position.{c}' for c i
 _CONTROLLER_STATE = MessageReader(SwivelControllerState, _STAMP + (
     'set_point', 'measured', 'measured_rate', 'torque', 'swivel_command_stamp.sec',
     'swivel_command_stamp.nanosec'))
-_IMU = MessageReader(Imu, _STAMP + tuple(f'orientation.{c}' for c in 'xyzw'))
+_IMU = MessageReader(Imu, _STAMP + tuple(f'orientation.{c}' for c in 'xyzw')
+                     + tuple(f'angular_velocity.{c}' for c in 'xyz'))
 
 
 def odom_fields(data: bytes) -> tuple[Time, float, float, tuple[float, float, float, float],
@@ -76,7 +77,12 @@ def controller_state_fields(data: bytes) -> tuple[Time, float, float, float, flo
             Time(sec=heard_sec, nanosec=heard_nanosec))
 
 
-def imu_fields(data: bytes) -> tuple[Time, tuple[float, float, float, float]]:
-    """Read a serialized sensor_msgs/Imu: its stamp and orientation quaternion (x, y, z, w)."""
-    sec, nanosec, *orientation = _IMU(data)
-    return Time(sec=sec, nanosec=nanosec), tuple(orientation)
+def imu_fields(data: bytes) -> tuple[Time, tuple[float, float, float, float],
+                                     tuple[float, float, float]]:
+    """
+    Read a serialized sensor_msgs/Imu.
+
+    Returns its stamp, orientation quaternion (x, y, z, w) and angular velocity [rad/s].
+    """
+    sec, nanosec, *values = _IMU(data)
+    return Time(sec=sec, nanosec=nanosec), tuple(values[:4]), tuple(values[4:])

@@ -179,6 +179,7 @@ class PlannerNode(Node):
         self._plans = _PlanWorker(self)
         self._liveness = InputLiveness(_INPUTS, self._ready_timeout)
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
+        self._attitude = inputs.Attitude(self.config.attitude_time_constant)
         self._refusals = inputs.RefusalLog(5.0)  # [s] as read_logged's lines
 
         # Serialized: the planner reads a few fields of each (conversions.odom_fields).
@@ -290,7 +291,7 @@ class PlannerNode(Node):
             bool(msg.left_end_seen), bool(msg.right_end_seen)))
 
     def _on_imu(self, data: bytes) -> None:
-        self._take(inputs.IMU, data, imu_fields, inputs.imu_values)
+        self._take(inputs.IMU, data, imu_fields, self._attitude.update, stamped=True)
 
     def _on_controller_state(self, data: bytes) -> None:
         def values(set_point, swivel, swivel_rate, torque, command_stamp):
@@ -299,8 +300,13 @@ class PlannerNode(Node):
 
         self._take(_CONTROLLER_STATE, data, controller_state_fields, values)
 
-    def _take(self, topic: str, data: bytes, read: Callable, values: Callable) -> None:
-        """Read a serialized input and add its values, while a climb runs; refuse a bad one."""
+    def _take(self, topic: str, data: bytes, read: Callable, values: Callable,
+              stamped: bool = False) -> None:
+        """
+        Read a serialized input and add its values, while a climb runs; refuse a bad one.
+
+        ``stamped``: ``values`` takes the message's stamp [s] before its fields.
+        """
         if not self._heard(topic):
             return
         fields = read_logged(self.get_logger(), read, data, topic)
@@ -308,7 +314,7 @@ class PlannerNode(Node):
             return
         stamp, *raw = fields
         try:
-            value = values(*raw)
+            value = values(stamp_to_seconds(stamp), *raw) if stamped else values(*raw)
         except ValueError as error:
             line = self._refusals.line(topic, str(error), time.monotonic())
             if line is not None:
@@ -398,6 +404,7 @@ class PlannerNode(Node):
         # The climb starts from the moments after its planning (seconds, when a backup is
         # searched): a tick of the inputs collected before would be that old.
         self._sync.clear()
+        self._attitude = inputs.Attitude(self.config.attitude_time_constant)
         self._slot.planned(climb)
         self._liveness.climb_started(self._now(), time.monotonic())
         self.get_logger().info(

@@ -35,9 +35,12 @@ def test_imu_fields_are_the_messages(frame_id):
     msg.orientation.x, msg.orientation.y, msg.orientation.z = 0.01, 0.2, -0.03
     msg.orientation.w = 0.97
     msg.orientation_covariance = [-1.0] * 9
-    stamp, quaternion = imu_fields(serialize_message(msg))
+    msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = 0.5, -0.25, 2.0
+    msg.angular_velocity_covariance = [9.0] * 9
+    stamp, quaternion, angular_velocity = imu_fields(serialize_message(msg))
     assert (stamp.sec, stamp.nanosec) == (7, 10_000_000)
     assert quaternion == (0.01, 0.2, -0.03, 0.97)
+    assert angular_velocity == (0.5, -0.25, 2.0)
 
 
 @pytest.mark.parametrize('frame_id', FRAME_IDS)

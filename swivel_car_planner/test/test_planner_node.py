@@ -71,6 +71,7 @@ class Rig:
         self.command = None
         self.received: list[SwivelCommand] = []
         self.heard = TimeMsg()  # the stamp of the last command, as the controller reports it
+        self._last_imu = None  # (time [s], pitch [rad]) of the last imu published
         self.node.create_subscription(SwivelCommand, 'swivel_command', self._on_command, 10)
         self.clock = self.node.create_publisher(Clock, '/clock', 10)
         self.imu = self.node.create_publisher(Imu, 'imu', 10)
@@ -113,6 +114,12 @@ class Rig:
             cp, sp = math.cos(obs.pitch / 2.0), math.sin(obs.pitch / 2.0)
             msg.orientation.x, msg.orientation.y = -sy * sp, cy * sp
             msg.orientation.z, msg.orientation.w = sy * cp, cy * cp
+            # The gyro as the pitch moves since the last imu (the car turns about z only by
+            # its heading, which the planner takes from the orientation).
+            last_time, last_pitch = self._last_imu or (car.time, obs.pitch)
+            if car.time > last_time:
+                msg.angular_velocity.y = (obs.pitch - last_pitch) / (car.time - last_time)
+            self._last_imu = (car.time, obs.pitch)
             self.imu.publish(msg)
         if 'odom' in inputs:
             msg = Odometry()

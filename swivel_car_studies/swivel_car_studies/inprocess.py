@@ -346,6 +346,7 @@ class _Period:
     velocities: list[float]  # [rad/s]
     orientation: list[float]  # [1] ground-truth quaternion x, y, z, w
     measured: list[float]  # [1] the imu's quaternion
+    rate: list[float]  # [rad/s] the imu's angular velocity
     swivel: Any = None  # the controller's swivel joint reading
     out: ControlOutput | None = None  # the controller's answer; None: a joint missing
     odom_due: bool = False  # the odometry publishes this period
@@ -418,6 +419,7 @@ class InProcessStack:
             self.car, c.steer_joint, c.rear_left_wheel_joint, c.rear_right_wheel_joint,
             c.yaw_rate_source, c.odometry_publish_rate)
         self._sync = InputSync(inputs.INPUTS, inputs.CONTROLLER_STATE)
+        self._attitude = inputs.Attitude(c.planner.attitude_time_constant)
         self._command_heard = -math.inf  # [s] stamp of the last swivel_command
         self.machine: ClimbStateMachine | None = None
         self._detected_climb = False  # the running climb follows the detector
@@ -542,10 +544,10 @@ class InProcessStack:
                 self._periods += 1
                 return
             positions, velocities = sample.positions.tolist(), sample.velocities.tolist()
-            measured = sample.orientation.tolist()
+            measured, rate = sample.orientation.tolist(), sample.angular_velocity.tolist()
         else:
-            measured = orientation
-        period = _Period(t, state, positions, velocities, orientation, measured)
+            measured, rate = orientation, state.angular_velocity.tolist()
+        period = _Period(t, state, positions, velocities, orientation, measured, rate)
         for stage in self._chain:
             stage(period)
         self._periods += 1
@@ -574,7 +576,8 @@ class InProcessStack:
         t, out = p.t, p.out
         ticks = []
         if self._periods % self.config.sim.imu_every == 0:
-            ticks += self._sync.add(inputs.IMU, t, inputs.imu_values(p.measured))
+            ticks += self._sync.add(inputs.IMU, t, self._attitude.update(t, p.measured,
+                                                                         p.rate))
         if p.odom_due:
             o = self.odometry.odometry
             ticks += self._sync.add(inputs.ODOM, t, inputs.odom_values(
@@ -725,6 +728,8 @@ class InProcessStack:
                                     request.step_distance, request.step_yaw,
                                     request.time_allowance)
         self.machine = machine
+        # As the node: the attitude the climb trusts starts at its first tick's fused angles.
+        self._attitude = inputs.Attitude(self.config.planner.attitude_time_constant)
         allowance = (request.time_allowance if request.time_allowance > 0.0
                      else self.config.planner.time_allowance)
         limit = self._periods_for(allowance + _CLIMB_SLACK)

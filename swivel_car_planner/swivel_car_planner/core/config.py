@@ -106,6 +106,10 @@ class PlannerConfig:
         'they parted by more than 0.25 rad) [rad]')
     no_progress_time: float = described(4.0, 'window of the no-progress monitor [s]')
     min_progress: float = described(0.01, 'path length the car must make in that window [m]')
+    attitude_time_constant: float = described(
+        10.0, "roll and pitch: the gyro's integral, pulled towards the IMU's fused angles with "
+        'this time constant (bandwidth 1/(2 pi it)): the fused angles take a jolt for a tilt '
+        '(core.inputs.Attitude) [s]')
     pitch_abort_margin: float = described(
         0.08, 'abort when the nose-up pitch comes this near the tip-over rule [rad]')
     time_allowance: float = described(60.0, 'default climb time limit, sim time [s]')
@@ -122,6 +126,7 @@ class PlannerConfig:
                      'swivel_tolerance', 'settle_rate', 'stop_speed',
                      'stall_progress',
                      'stall_time', 'slip_yaw_tolerance', 'no_progress_time', 'min_progress',
+                     'attitude_time_constant',
                      'time_allowance'):
             if getattr(self, name) <= 0.0:
                 raise ValueError(f'{name} must be > 0, got {getattr(self, name)!r}')
