@@ -337,9 +337,12 @@ def test_reset_puts_the_robot_at_rest_at_the_pose_and_keeps_time_moving(sim):
     sim.reset(1.0, -2.0, 0.7)
     state = sim.state()
     assert state.time == time_before
-    # Bullet places the base through its centre of mass in single precision: ~1e-8 m.
+    # Bullet holds poses in single precision (physics.py), placing the base through its centre
+    # of mass: a few float32 roundings, 2^-24 of the coordinate each. Measured over 150 poses
+    # within 5 m of the origin: position <= 4.4e-7 m, yaw <= 7.9e-7 rad (above pytest.approx's
+    # default 1e-6 relative at 0.7 rad); x2 and x6 margin.
     np.testing.assert_allclose(state.position, [1.0, -2.0, sim.config.params.r], atol=1e-6)
-    assert state.yaw == pytest.approx(0.7)
+    assert state.yaw == pytest.approx(0.7, abs=5e-6)
     np.testing.assert_allclose(state.positions, 0.0, atol=1e-12)
     np.testing.assert_allclose(state.linear_velocity, 0.0, atol=1e-12)
 
@@ -387,8 +390,10 @@ def test_step_is_placed_relative_to_the_robot_pose(sim):
     heading = np.array([math.cos(0.5), math.sin(0.5)])
     edge = np.array([1.0, 2.0]) + (p.wheelbase + 0.3) * heading
     normal = np.array([math.cos(0.75), math.sin(0.75)])
-    np.testing.assert_allclose(centre, [*(edge + 0.2 * normal), 0.1], atol=1e-9)
-    assert pybullet.getEulerFromQuaternion(orientation)[2] == pytest.approx(0.75)
+    # Single precision (physics.py): measured over 150 poses and steps within 5 m of the
+    # origin, the centre is placed within 1.0e-6 m and turned within 4.7e-7 rad; x5 margin.
+    np.testing.assert_allclose(centre, [*(edge + 0.2 * normal), 0.1], rtol=0.0, atol=5e-6)
+    assert pybullet.getEulerFromQuaternion(orientation)[2] == pytest.approx(0.75, abs=5e-6)
 
 
 def test_swivel_lift_puts_the_front_axle_on_a_step_that_blocks_driving_straight():
@@ -424,8 +429,12 @@ def test_show_state_places_the_robot_and_render_draws_it(sim):
         pybullet.getQuaternionFromEuler([0.0, -0.1, 0.5]))
     sim.show_state(position, orientation, {'swivel_joint': 0.4})
     state = sim.state()
-    np.testing.assert_allclose(state.position, position, atol=1e-6)  # single precision
-    np.testing.assert_allclose(np.abs(state.orientation @ orientation), 1.0, atol=1e-9)
+    # Single precision (physics.py), measured over 150 random poses within 5 m of the origin:
+    # position <= 3.5e-7 m; |q . q'| within 1.8e-7 of 1 (float32 quaternion components), so
+    # 1e-6 (1 - cos(d/2) = d^2/8) still catches an orientation 3e-3 rad off.
+    np.testing.assert_allclose(state.position, position, atol=1e-6)
+    np.testing.assert_allclose(np.abs(state.orientation @ orientation), 1.0, rtol=0.0,
+                               atol=1e-6)
     assert math.isclose(state.positions[0], 0.4, abs_tol=1e-9)
     image = sim.render(width=64, height=48)
     assert image.shape == (48, 64, 3) and image.dtype == np.uint8
