@@ -12,7 +12,7 @@ from swivel_car_msgs.msg import DetectedStep
 from swivel_car_msgs.srv import ClimbStep
 from swivel_car_perception.core.detector import Detection
 from swivel_car_planner.core import ClimbRequest, ErrorCode
-from swivel_car_planner.core.detected import DetectedSteps, UNSEEN_REACH
+from swivel_car_planner.core.detected import DetectedSteps
 from swivel_car_planner.core.geometry import Pose2D, StepEdge
 from swivel_car_planner.planner_node import PlannerNode
 from swivel_car_testing import next_domain_id, spin_until
@@ -51,18 +51,18 @@ def test_a_height_above_the_limit_within_its_uncertainty_is_the_limits():
     assert request.step_height == pytest.approx(0.0825)
 
 
-def test_an_end_not_seen_lies_beyond_what_was_seen():
+def test_an_end_not_seen_bounds_the_face_where_it_was_seen():
+    # The face was taken to reach 2 m past an end not seen, and as of unknown width (held
+    # heading, no side limit) with neither end seen: a 7 cm step 0.26 m ahead, 1.1 m wide
+    # (0.91 m seen) was climbed straight and a wheel fell off its side (rolled 0.24 rad),
+    # where the told climb repositioned to cross within the face.
     steps = DetectedSteps(FRONT_AXLE, max_age=0.5)
     steps.pose(10.0, 0.0, 0.0, 0.0)
     one_end = replace(_step(yaw=0.0), right_end_seen=False)  # seen from -0.5 to 0.7 m
-    steps.heard(10.0, one_end)
-    request, _ = steps.request(ClimbRequest(0.0, 0.0, 0.0), now=10.1)
-    assert request.step_offset + request.step_width / 2.0 == pytest.approx(0.7)
-    assert request.step_offset - request.step_width / 2.0 == pytest.approx(-0.5 - UNSEEN_REACH)
-    steps.pose(10.1, 0.0, 0.0, 0.0)
-    steps.heard(10.1, replace(one_end, left_end_seen=False))
-    request, _ = steps.request(ClimbRequest(0.0, 0.0, 0.0), now=10.1)
-    assert request.step_width == 0.0  # not known: the planner only holds its heading
+    for detection in (one_end, replace(one_end, left_end_seen=False)):
+        steps.heard(10.0, detection)
+        request, _ = steps.request(ClimbRequest(0.0, 0.0, 0.0), now=10.1)
+        assert (request.step_width, request.step_offset) == pytest.approx((1.2, 0.1))
 
 
 @pytest.mark.parametrize('setup, words', [

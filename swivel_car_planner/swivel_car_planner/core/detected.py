@@ -21,9 +21,6 @@ from swivel_car_planner.core.request import ClimbRequest
 from swivel_car_planner.core.state_machine import ClimbStateMachine, Observation
 from swivel_car_planner.core.steps import Step
 
-# An end of the edge the camera did not see lies somewhere beyond what it saw: the request's
-# face reaches this far on that side: beyond any crossing the approach can reach.
-UNSEEN_REACH = 2.0  # [m] (the offset stays within the request's 3 m)
 # Nearer than this to the front axle, the front wheels (swung by the swivel while the car
 # turns onto its approach) hide parts of the riser: the edge's yaw jumped by 0.05-0.07 rad
 # between frames there (detected climb benchmark), so such detections correct nothing.
@@ -100,24 +97,19 @@ class DetectedSteps:
         """
         Return ``request`` with the fresh detection's step, or None and why (one line).
 
-        An end the camera did not see is taken ``UNSEEN_REACH`` beyond the part it saw;
-        neither end seen: the width is not known (0). A height above the whole car's
-        ``limit`` [m] by no more than twice its one-sigma is the limit's: the detection
-        cannot tell that step from one at the limit.
+        The face is the part the camera saw, also where it did not see an end (the face
+        reaches at least that far, and the planner keeps every wheel on it). A height above
+        the whole car's ``limit`` [m] by no more than twice its one-sigma is the limit's: the
+        detection cannot tell that step from one at the limit.
         """
         d, why = self.fresh(now)
         if d is None:
             return None, why
         if limit < d.height <= limit + 2.0 * d.height_std:
             d = replace(d, height=limit)
-        left = d.offset + d.width / 2.0 + (0.0 if d.left_end_seen else UNSEEN_REACH)  # [m]
-        right = d.offset - d.width / 2.0 - (0.0 if d.right_end_seen else UNSEEN_REACH)
-        if not (d.left_end_seen or d.right_end_seen):
-            left = right = 0.0
         self._height = d.height
         return replace(request, step_height=d.height, step_distance=max(0.0, d.distance),
-                       step_yaw=d.yaw, step_width=left - right,
-                       step_offset=(left + right) / 2.0), ''
+                       step_yaw=d.yaw, step_width=d.width, step_offset=d.offset), ''
 
     def correction(self, edge: StepEdge, now: float) -> StepEdge | None:
         """
