@@ -34,25 +34,6 @@ _CLOCK_SLACK = 0.5  # [s]
 _NO_STAMP = TimeMsg()  # a source's stamp in the controller state while none was heard
 
 
-CONFIG_DESCRIPTIONS = {
-    'max_integral_torque': 'clamp on the PID integral contribution [N m]',
-    'integral_band': 'while the set point ramps, the PID integrates only while |error| is '
-                     'below this [rad]',
-    'max_swivel_rate': 'swivel set-point rate limit [rad/s]',
-    'max_linear_velocity': 'forward speed limit of base_link [m/s]',
-    'max_linear_acceleration': 'forward acceleration limit [m/s^2]',
-    'max_angular_velocity': 'yaw rate limit [rad/s]',
-    'max_angular_acceleration': 'yaw acceleration limit [rad/s^2]',
-    'cmd_vel_timeout': 'deadman: older cmd_vel stops the drive, holds the swivel; 0 disables [s]',
-    'swivel_command_timeout': 'deadman: a held swivel_command not renewed for this long (node '
-                              'clock, from receipt) is released: drive stops, swivel holds, '
-                              'cmd_vel steers again; 0 disables [s]',
-    'slowdown_start': 'swivel error below which the drive runs at full speed [rad]',
-    'slowdown_stop': 'swivel error above which the drive stops; cos(error) between [rad]',
-    'tip_over_margin': 'margin on thesis eq. 72, (pi - phi)/2 - theta1 >= margin [rad]',
-}
-
-
 class ControllerNode(Node):
     """Event-driven swivel car controller; see the package README for its interface."""
 
@@ -60,7 +41,7 @@ class ControllerNode(Node):
         super().__init__('controller', **kwargs)
         robot = declare_description(self)
         car = robot.model_params()
-        config = declare_dataclass(self, ControllerConfig, CONFIG_DESCRIPTIONS,
+        config = declare_dataclass(self, ControllerConfig,
                                    given={'max_torque': robot.swivel_torque_limit})
         self._use_stamped = self.declare_parameter(
             'use_stamped', True, ParameterDescriptor(

@@ -23,6 +23,7 @@ from swivel_car_control.core.joint_states import (
     JointStateOdometry, MAX_SWIVEL_RATE, yaw_quaternion, YAW_RATE_SOURCES)
 from swivel_car_control.core.odometry_input import GatedOdometry, Verdict, WHEEL_RATE_FACTOR
 from swivel_car_control.joints import MissingJointError
+from swivel_car_model.description import described
 from swivel_car_msgs.srv import SetPose2D
 from swivel_car_ros.ros_params import (
     declare_dataclass, declare_description, live_parameters, run_node, stamp_to_seconds,
@@ -34,21 +35,30 @@ from tf2_msgs.msg import TFMessage
 
 @dataclass(frozen=True)
 class OdometryConfig:
-    """Frames, rates and covariances of the odometry node (see CONFIG_DESCRIPTIONS)."""
+    """Frames, rates and covariances of the odometry node (descriptions: each field's metadata)."""
 
-    publish_rate: float = 100.0  # [Hz]
-    odom_frame_id: str = 'odom'
-    base_frame_id: str = 'base_link'
-    tf_frame_prefix: str = ''
-    enable_odom_tf: bool = True
+    publish_rate: float = described(
+        100.0, 'rate of odom (and TF) messages, by joint_states time: at most one per '
+        'joint_states, each stamped with it [Hz]')
+    odom_frame_id: str = described('odom', 'fixed frame of the odometry (header.frame_id)')
+    base_frame_id: str = described('base_link', 'robot frame (child_frame_id)')
+    tf_frame_prefix: str = described(
+        '', 'prefix for both frame ids, e.g. a robot name; empty = none')
+    enable_odom_tf: bool = described(True, 'broadcast odom -> base_link on /tf')
     # [m^2, m^2, m^2, rad^2, rad^2, rad^2] for x, y, z, roll, pitch, yaw
-    pose_covariance_diagonal: tuple = (0.001, 0.001, 1e6, 1e6, 1e6, 0.01)
+    pose_covariance_diagonal: tuple = described(
+        (0.001, 0.001, 1e6, 1e6, 1e6, 0.01), 'pose covariance diagonal x y z roll pitch yaw '
+        '[m^2, rad^2]')
     # [(m/s)^2 x3, (rad/s)^2 x3]
-    twist_covariance_diagonal: tuple = (0.001, 0.001, 1e6, 1e6, 1e6, 0.01)
-    swivel_joint: str = 'swivel_joint'
-    rear_left_wheel_joint: str = 'rear_left_wheel_joint'
-    rear_right_wheel_joint: str = 'rear_right_wheel_joint'
-    yaw_rate_source: str = 'swivel'
+    twist_covariance_diagonal: tuple = described(
+        (0.001, 0.001, 1e6, 1e6, 1e6, 0.01), 'twist covariance diagonal [(m/s)^2, (rad/s)^2]')
+    swivel_joint: str = described('swivel_joint', 'swivel joint name in joint_states')
+    rear_left_wheel_joint: str = described('rear_left_wheel_joint', 'rear left wheel joint name')
+    rear_right_wheel_joint: str = described(
+        'rear_right_wheel_joint', 'rear right wheel joint name')
+    yaw_rate_source: str = described(
+        'swivel', "yaw rate from 'swivel' (offset tricycle steering constraint) or 'rear_wheels' "
+        '(rear wheel rate difference / track)')
     # What the node applies while running; the rest is read-only.
     LIVE: ClassVar[tuple[str, ...]] = ('pose_covariance_diagonal', 'twist_covariance_diagonal')
 
@@ -76,23 +86,6 @@ class OdometryConfig:
         return f'{prefix}/{frame_id}' if prefix else frame_id
 
 
-CONFIG_DESCRIPTIONS = {
-    'publish_rate': 'rate of odom (and TF) messages, by joint_states time: at most one per '
-                    'joint_states, each stamped with it [Hz]',
-    'odom_frame_id': 'fixed frame of the odometry (header.frame_id)',
-    'base_frame_id': 'robot frame (child_frame_id)',
-    'tf_frame_prefix': 'prefix for both frame ids, e.g. a robot name; empty = none',
-    'enable_odom_tf': 'broadcast odom -> base_link on /tf',
-    'pose_covariance_diagonal': 'pose covariance diagonal x y z roll pitch yaw [m^2, rad^2]',
-    'twist_covariance_diagonal': 'twist covariance diagonal [(m/s)^2, (rad/s)^2]',
-    'swivel_joint': 'swivel joint name in joint_states',
-    'rear_left_wheel_joint': 'rear left wheel joint name',
-    'rear_right_wheel_joint': 'rear right wheel joint name',
-    'yaw_rate_source': "yaw rate from 'swivel' (offset tricycle steering constraint) or "
-                       "'rear_wheels' (rear wheel rate difference / track)",
-}
-
-
 def _diagonal(values: tuple) -> list[float]:
     matrix = [0.0] * 36
     for i, value in enumerate(values):
@@ -107,7 +100,7 @@ class OdometryNode(Node):
         super().__init__('odometry', **kwargs)
         robot = declare_description(self)
         self._car = robot.model_params()
-        self._config = config = declare_dataclass(self, OdometryConfig, CONFIG_DESCRIPTIONS)
+        self._config = config = declare_dataclass(self, OdometryConfig)
         joint_odometry = JointStateOdometry(
             self._car, config.swivel_joint, config.rear_left_wheel_joint,
             config.rear_right_wheel_joint, config.yaw_rate_source, config.publish_rate)

@@ -17,6 +17,7 @@ from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import ColorRGBA
+from swivel_car_model.description import described
 from swivel_car_msgs.msg import DetectedStep
 from swivel_car_perception.core.detector import (
     Detection, DetectorConfig, Mount, StepDetector)
@@ -33,15 +34,23 @@ REFUSAL_INTERVAL = 5.0  # [s] wall time between two lines about one kind of refu
 
 @dataclass(frozen=True)
 class StepDetectorConfig:
-    """The node's parameters (see CONFIG_DESCRIPTIONS)."""
+    """The node's parameters (descriptions: each field's metadata)."""
 
-    base_frame_id: str = 'base_link'
-    min_height: float = 0.012  # [m]
-    max_distance: float = 2.2  # [m]
-    max_lateral: float = 2.0  # [m]
-    odom_drift: float = 0.02  # [1]
-    gate: float = 5.0  # [1]
-    max_misses: int = 3
+    base_frame_id: str = described(
+        'base_link', 'frame of detected_step and the markers (REP-105 base_link)')
+    min_height: float = described(
+        0.012, 'lowest step reported: raised points are this much above the ground [m]')
+    max_distance: float = described(
+        2.2, "farthest step edge reported, from the front axle's ground contact [m]")
+    max_lateral: float = described(
+        2.0, "points farther aside than this from base_link's x axis are left out [m]")
+    odom_drift: float = described(
+        0.02, 'odometry drift per metre driven (1 sigma) that the fused estimate allows [1]')
+    gate: float = described(
+        5.0, 'a detection further than this many sigmas from the fused estimate starts a new one '
+        '[1]')
+    max_misses: int = described(
+        3, 'frames without a detection before the fused estimate is dropped [1]')
 
     def __post_init__(self) -> None:
         if not isinstance(self.base_frame_id, str) or not self.base_frame_id:
@@ -56,27 +65,13 @@ class StepDetectorConfig:
             raise ValueError(f'max_misses must be a whole number >= 0, got {self.max_misses!r}')
 
 
-CONFIG_DESCRIPTIONS = {
-    'base_frame_id': 'frame of detected_step and the markers (REP-105 base_link)',
-    'min_height': 'lowest step reported: raised points are this much above the ground [m]',
-    'max_distance': "farthest step edge reported, from the front axle's ground contact [m]",
-    'max_lateral': "points farther aside than this from base_link's x axis are left out [m]",
-    'odom_drift': 'odometry drift per metre driven (1 sigma) that the fused estimate allows '
-                  '[1]',
-    'gate': 'a detection further than this many sigmas from the fused estimate starts a new '
-            'one [1]',
-    'max_misses': 'frames without a detection before the fused estimate is dropped [1]',
-}
-
-
 class StepDetectorNode(Node):
     """The step detector on the depth camera; see the package README for its interface."""
 
     def __init__(self, **kwargs) -> None:
         super().__init__('step_detector', **kwargs)
         robot = declare_description(self)
-        self._config = config = declare_dataclass(self, StepDetectorConfig,
-                                                  CONFIG_DESCRIPTIONS)
+        self._config = config = declare_dataclass(self, StepDetectorConfig)
         self._mount = Mount.of(robot)
         self._detector_config = DetectorConfig(
             min_height=config.min_height, max_distance=config.max_distance,

@@ -49,10 +49,12 @@ def moment_seconds(stamp: Time) -> float:
     return -math.inf if is_zero_stamp(stamp) else stamp_to_seconds(stamp)
 
 
-def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],
-                      given: Mapping[str, Any] | None = None) -> T:
+def declare_dataclass(node: Node, cls: type[T], given: Mapping[str, Any] | None = None) -> T:
     """
     Declare one parameter per field of ``cls`` and build it from their values.
+
+    The fields are ``swivel_car_model.description.described``: each one's default and
+    description (with its unit) are its parameter's, its validation the dataclass's.
 
     The fields in ``given`` (stated elsewhere) are not declared. All are read-only but the
     fields ``cls.LIVE`` names (if it has that class attribute), which its node applies while
@@ -75,7 +77,7 @@ def declare_dataclass(node: Node, cls: type[T], descriptions: Mapping[str, str],
         value = node.declare_parameter(
             field.name, list(default) if isinstance(default, tuple) else default,
             # Dynamic typing lets `kp:=19` (an integer) through; the dataclass validates.
-            ParameterDescriptor(description=descriptions[field.name], dynamic_typing=True,
+            ParameterDescriptor(description=field.metadata['description'], dynamic_typing=True,
                                 read_only=field.name not in live)).value
         values[field.name] = tuple(value) if isinstance(default, tuple) else value
     return cls(**values)

@@ -18,6 +18,7 @@ from swivel_car_control.core.steering import (
     SteeringMap, swivel_is_tip_safe, tip_safe_swivel_limit)
 from swivel_car_model import planar
 from swivel_car_model.checks import check_number
+from swivel_car_model.description import described
 from swivel_car_model.params import SwivelCarParams
 
 SOURCE_CMD_VEL = 'cmd_vel'
@@ -30,49 +31,31 @@ class ControllerConfig:
     """
     Limits and behaviour of the controller (the PID gains live in ``SwivelCarParams``).
 
-    Parameters
-    ----------
-    max_torque : float
-        Swivel torque clamp. # [N m]
-    max_integral_torque : float
-        Clamp on the PID's integral contribution. # [N m]
-    integral_band : float
-        While the set point ramps, the PID integrates only while |set point - measured| is
-        below this (resting, it always integrates). # [rad]
-    max_swivel_rate : float
-        Set-point rate limit. # [rad/s]
-    max_linear_velocity, max_linear_acceleration : float
-        Limits on base_link's forward speed. # [m/s], [m/s^2]
-    max_angular_velocity, max_angular_acceleration : float
-        Limits on the commanded yaw rate. # [rad/s], [rad/s^2]
-    cmd_vel_timeout : float
-        Deadman: a cmd_vel older than this stops the drive and holds the swivel; 0 disables.
-        # [s]
-    swivel_command_timeout : float
-        Deadman for the planner: a held swivel_command not renewed for this long is released
-        (the drive stops, the swivel holds, cmd_vel steers again); 0 disables. The planner
-        repeats its command every control cycle. # [s]
-    slowdown_start, slowdown_stop : float
-        Swivel error (target - measured) below which the drive runs at full speed, and above
-        which it stops; cos(error) between. # [rad]
-    tip_over_margin : float
-        Margin on thesis eq. 72: ``(pi - phi)/2 - theta1 >= tip_over_margin``. # [rad]
-
+    Each field's metadata ``description`` (with its unit) is also its ROS parameter's.
     """
 
-    max_torque: float = 30.0  # [N m]
-    max_integral_torque: float = 15.0  # [N m]
-    integral_band: float = 0.05  # [rad]
-    max_swivel_rate: float = 1.5  # [rad/s]
-    max_linear_velocity: float = 0.5  # [m/s]
-    max_linear_acceleration: float = 1.0  # [m/s^2]
-    max_angular_velocity: float = 2.0  # [rad/s]
-    max_angular_acceleration: float = 4.0  # [rad/s^2]
-    cmd_vel_timeout: float = 0.5  # [s]
-    swivel_command_timeout: float = 0.5  # [s]
-    slowdown_start: float = 0.15  # [rad]
-    slowdown_stop: float = 0.6  # [rad]
-    tip_over_margin: float = 0.1  # [rad]
+    max_torque: float = described(
+        30.0, 'swivel torque clamp; the node sets it to the swivel_torque_limit [N m]')
+    max_integral_torque: float = described(15.0, 'clamp on the PID integral contribution [N m]')
+    integral_band: float = described(
+        0.05, 'while the set point ramps, the PID integrates only while |error| is below this '
+        '[rad]')
+    max_swivel_rate: float = described(1.5, 'swivel set-point rate limit [rad/s]')
+    max_linear_velocity: float = described(0.5, 'forward speed limit of base_link [m/s]')
+    max_linear_acceleration: float = described(1.0, 'forward acceleration limit [m/s^2]')
+    max_angular_velocity: float = described(2.0, 'yaw rate limit [rad/s]')
+    max_angular_acceleration: float = described(4.0, 'yaw acceleration limit [rad/s^2]')
+    cmd_vel_timeout: float = described(
+        0.5, 'deadman: older cmd_vel stops the drive, holds the swivel; 0 disables [s]')
+    swivel_command_timeout: float = described(
+        0.5, 'deadman: a held swivel_command not renewed for this long (node clock, from '
+        'receipt) is released: drive stops, swivel holds, cmd_vel steers again; 0 disables [s]')
+    slowdown_start: float = described(
+        0.15, 'swivel error below which the drive runs at full speed [rad]')
+    slowdown_stop: float = described(
+        0.6, 'swivel error above which the drive stops; cos(error) between [rad]')
+    tip_over_margin: float = described(
+        0.1, 'margin on thesis eq. 72, (pi - phi)/2 - theta1 >= margin [rad]')
     # The fields ``SwivelController.step`` reads afresh every period: they may change while
     # it runs (``reconfigure``).
     LIVE: ClassVar[tuple[str, ...]] = ('cmd_vel_timeout', 'swivel_command_timeout',
