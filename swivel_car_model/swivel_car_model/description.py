@@ -296,8 +296,12 @@ class CarDescription:
             swivel_limit=self.swivel_limit, swivel_torque_limit=self.swivel_torque_limit)
 
 
-PARAMETERS: dict[str, tuple[Any, str]] = {
-    item.name: (item.default, item.metadata['description']) for item in fields(CarDescription)}
+def parameters_of(cls: type) -> dict[str, tuple[Any, str]]:
+    """Return name -> (default, description) of the ``described`` fields of ``cls``."""
+    return {item.name: (item.default, item.metadata['description']) for item in fields(cls)}
+
+
+PARAMETERS = parameters_of(CarDescription)
 
 
 @dataclass(frozen=True)

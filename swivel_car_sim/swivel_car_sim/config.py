@@ -12,63 +12,84 @@ import math
 
 from swivel_car_model import description
 from swivel_car_model.checks import check_finite_number
+from swivel_car_model.description import described
 from swivel_car_sim.physics import SimConfig
 from swivel_car_sim.sensor_models import SensorProfile
 
 CLOCK_SOURCES = ('sim', 'wall')
 
+
+@dataclass(frozen=True)
+class SimParameters:
+    """
+    The sim node's own parameters.
+
+    Each field's default and description are its ROS parameter's; ``SimNodeConfig.from_values``
+    validates them all.
+    """
+
+    gui: bool = described(False, 'open the pybullet GUI window (needs a display)')
+    time_step: float = described(0.002, '[s] physics step')
+    control_period: float = described(
+        0.01, '[s] joint_states/imu/odom period and lockstep advance; a multiple of time_step')
+    real_time_factor: float = described(
+        1.0, '[1] sim time per wall time when free running; 0 = as fast as possible')
+    lockstep: bool = described(
+        False, 'advance one control_period per ActuatorCommand stamped with the last '
+        'joint_states stamp')
+    lockstep_timeout: float = described(
+        1.0, '[s] wall time to wait for the command in lockstep (or free running, see '
+        'max_command_age); then the sim runs at real time (free running: at real_time_factor) '
+        'until a command comes; 0 = wait forever')
+    lockstep_real_time_factor: float = described(
+        0.0, '[1] in lockstep, at most this much sim time per wall time, so that nodes outside '
+        'the lockstep keep up; 0 = as fast as the controller answers')
+    max_command_age: float = described(
+        0.01, '[s] sim time; free running with clock_source sim: the sim steps on from a state '
+        'only while its newest actuator_command answers a state at most this much older, else it '
+        'waits for the controller (at most lockstep_timeout), and it drops older commands; 0 = '
+        'the command of the state itself')
+    watchdog_timeout: float = described(
+        0.5, '[s] sim time without a command after which the swivel torque is zeroed and the '
+        'drive stops; 0 disables')
+    robot_variant: str = described(
+        'swivel', "'swivel' or 'car_like' (baseline with a steered front axle)")
+    initial_x: float = described(0.0, '[m] initial base_link x in the world')
+    initial_y: float = described(0.0, '[m] initial base_link y in the world')
+    initial_yaw: float = described(0.0, '[rad] initial heading')
+    start_paused: bool = described(
+        False, 'start with the physics paused (~/set_paused false resumes)')
+    clock_rate: float = described(
+        10.0, '[Hz] /clock publish rate (sim time); control_period divided by a whole number. 10 '
+        'Hz, as gazebo_ros publishes: each node with use_sim_time takes every message (about 55 '
+        'us here), and at 100 Hz the lockstep chain takes 14 % more CPU; sim-time clocks move in '
+        'steps of 1/clock_rate')
+    imu_rate: float = described(
+        100.0, '[Hz] imu publish rate; control_period divided by a whole number')
+    ground_truth_rate: float = described(100.0, '[Hz] ground_truth/odom publish rate; as imu_rate')
+    ground_friction: float = described(1.0, '[1] friction coefficient of the ground')
+    body_collision: bool = described(
+        False, 'give the body collision shapes too, not only the wheels (a phi < 0 robot, whose '
+        'belly meets step edges)')
+    world_frame_id: str = described('world', 'fixed frame of ground_truth/odom and ~/reset_event')
+    base_frame_id: str = described(
+        'base_link', 'frame of the robot body: imu, ground_truth/odom child')
+    clock_source: str = described(
+        'sim', "'sim': stamps of sim time, /clock published; 'wall': as a driver board, stamps "
+        'from the system clock, no /clock, free running at real time (no lockstep), every other '
+        'node with use_sim_time false')
+    sensor_profile: str = described(
+        'ideal', "'ideal' (the exact state, commands applied as they come), 'realistic' "
+        '(config/sensor_profiles/realistic.yaml: encoders, IMU, latency and losses of named '
+        'parts) or a profile YAML path')
+    sensor_seed: int = described(
+        0, '[1] seed of every draw of the sensor models (lockstep stays deterministic)')
+
+
 # name -> (default, description). The node declares exactly these: its own, then the robot
 # description's (swivel_car_model.description, shared by every node).
 PARAMETERS: dict[str, tuple[object, str]] = {
-    'gui': (False, 'open the pybullet GUI window (needs a display)'),
-    'time_step': (0.002, '[s] physics step'),
-    'control_period': (0.01, '[s] joint_states/imu/odom period and lockstep advance; a '
-                             'multiple of time_step'),
-    'real_time_factor': (1.0, '[1] sim time per wall time when free running; 0 = as fast '
-                              'as possible'),
-    'lockstep': (False, 'advance one control_period per ActuatorCommand stamped with the '
-                        'last joint_states stamp'),
-    'lockstep_timeout': (1.0, '[s] wall time to wait for the command in lockstep (or free '
-                              'running, see max_command_age); then the sim runs at real time '
-                              '(free running: at real_time_factor) until a command comes; 0 = '
-                              'wait forever'),
-    'lockstep_real_time_factor': (0.0, '[1] in lockstep, at most this much sim time per wall '
-                                       'time, so that nodes outside the lockstep keep up; '
-                                       '0 = as fast as the controller answers'),
-    'max_command_age': (0.01, '[s] sim time; free running with clock_source sim: the sim '
-                              'steps on from a state only while its newest actuator_command '
-                              'answers a state at most this much older, else it waits for the '
-                              'controller (at most lockstep_timeout), and it drops older '
-                              'commands; 0 = the command of the state itself'),
-    'watchdog_timeout': (0.5, '[s] sim time without a command after which the swivel torque '
-                              'is zeroed and the drive stops; 0 disables'),
-    'robot_variant': ('swivel', "'swivel' or 'car_like' (baseline with a steered front axle)"),
-    'initial_x': (0.0, '[m] initial base_link x in the world'),
-    'initial_y': (0.0, '[m] initial base_link y in the world'),
-    'initial_yaw': (0.0, '[rad] initial heading'),
-    'start_paused': (False, 'start with the physics paused (~/set_paused false resumes)'),
-    'clock_rate': (10.0, '[Hz] /clock publish rate (sim time); control_period divided by a '
-                         'whole number. 10 Hz, as gazebo_ros publishes: each node with '
-                         'use_sim_time takes every message (about 55 us here), and at 100 Hz '
-                         'the lockstep chain takes 14 % more CPU; sim-time clocks move in '
-                         'steps of 1/clock_rate'),
-    'imu_rate': (100.0, '[Hz] imu publish rate; control_period divided by a whole number'),
-    'ground_truth_rate': (100.0, '[Hz] ground_truth/odom publish rate; as imu_rate'),
-    'ground_friction': (1.0, '[1] friction coefficient of the ground'),
-    'body_collision': (False, 'give the body collision shapes too, not only the wheels (a '
-                              'phi < 0 robot, whose belly meets step edges)'),
-    'world_frame_id': ('world', 'fixed frame of ground_truth/odom and ~/reset_event'),
-    'base_frame_id': ('base_link', 'frame of the robot body: imu, ground_truth/odom child'),
-    'clock_source': ('sim', "'sim': stamps of sim time, /clock published; 'wall': as a driver "
-                            'board, stamps from the system clock, no /clock, free running at '
-                            'real time (no lockstep), every other node with use_sim_time false'),
-    'sensor_profile': ('ideal', "'ideal' (the exact state, commands applied as they come), "
-                                "'realistic' (config/sensor_profiles/realistic.yaml: encoders, "
-                                'IMU, latency and losses of named parts) or a profile YAML path'),
-    'sensor_seed': (0, '[1] seed of every draw of the sensor models (lockstep stays '
-                       'deterministic)'),
-    **description.PARAMETERS,
-}
+    **description.parameters_of(SimParameters), **description.PARAMETERS}
 
 
 @dataclass(frozen=True)
