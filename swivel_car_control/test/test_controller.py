@@ -139,6 +139,8 @@ def test_free_swivel_command_gives_no_torque_and_holds_at_the_tip_safe_limit():
     # Held again from where it is: no jump of the set point.
     controller.set_swivel_command(0.5, 0.0, 0.0, True, 0.3)
     out = controller.step(0.31, 0.2, 0.0)
+    # One period's slew at max_swivel_rate (1.5 rad/s x 10 ms = 0.015 rad) towards the new
+    # target; a jump would move it the whole 0.9 rad to 0.5 rad.
     assert out.set_point == pytest.approx(controller.swivel_limit, abs=0.02)
 
 
