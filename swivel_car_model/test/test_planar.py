@@ -191,6 +191,9 @@ def test_odometry_bad_input_changes_nothing(bad, slot):
 def test_twist_is_smooth_through_zero_swivel(theta2):
     """Near zero the contact changes wheel; the twist must not see that jump as motion."""
     v, omega = planar.body_twist(P, theta2, 0.01, 5.0)
+    # The swivel's 0.01 rad/s moves the contact along x by 6e-4 of v here (the sign
+    # follows the contact's side: exact, not rounding), omega -1.5e-3 rad/s; the contact's
+    # change of wheel taken for motion would be orders of magnitude more.
     assert v == pytest.approx(5.0 * P.r, rel=1e-3)
     assert abs(omega) < 0.01
 
