@@ -18,6 +18,8 @@ def test_mass_and_inertia_are_derived_from_the_layout():
                            column_mass=1e-3, wheel_mass=1e-3)
     apex_x, apex_z = heavy.apex[0], heavy.apex[2]
     size_x, size_z = 0.4 * heavy.l, 0.25 * heavy.l
+    # The 1e-3 kg parts add 1.11e-3 of the total (with 1e-4 kg parts 1.11e-4: theirs, not a
+    # rounding); a box term or parallel-axis term wrong would be off by far more.
     assert heavy.inertia_about_rear_axle == pytest.approx(
         10.0 * (apex_x ** 2 + apex_z ** 2) + 10.0 * (size_x ** 2 + size_z ** 2) / 12.0,
         rel=2e-3)
