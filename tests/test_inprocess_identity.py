@@ -141,13 +141,11 @@ def _ros_climb(session: SimSession, recorder: _Recorder, request: ClimbStep.Requ
     session.spawn_step(HEIGHT, DISTANCE)
     session.set_paused(False)
     session.wait_ready()  # until the planner hears the stack
-    session.set_paused(True)
-    # One period stepped from the pause: its answer names the state the sim then holds, however
-    # late this node hears the states before it.
-    held = step_client.call_async(StepSimulation.Request(steps=sim.steps_per_period))
-    session.spin_until(held.done, 30.0, 'sim/step')
-    assert held.result().success, held.result().message
-    paused = _seconds(held.result().sim_time)  # [s] the state the sim stopped at
+    # Paused by sim/run, in lockstep: it names the state it holds, however late this node
+    # hears the states before it, and the controller has answered that state (sim/step would
+    # step on at once, with the answer to the state before if this one's was still on its
+    # way).
+    paused = _seconds(session.run(sim.steps_per_period))  # [s] the state the sim stopped at
     # Outside the chain the odometry may trail the sim: reset it once it has that state.
     session.spin_until(lambda: paused in recorder.commands and paused in recorder.odometry,
                        30.0, 'the controller and odometry to answer the paused state')
@@ -222,7 +220,7 @@ def test_a_ros_lockstep_climb_is_the_in_process_climb(ros_run):
         if len(rows):
             differing[name] = (float(times[rows[0]]), float(np.max(difference)))
     # Bit-identical: any difference would mean the two runs' inputs differ somewhere.
-    assert not differing, differing
+    assert not differing, (f'the climb from {first_tick} s', differing)
     assert ours.start_time == first_tick
     assert (ours.success, int(ours.error_code), ours.message) == (
         ros.success, ros.error_code, ros.message)

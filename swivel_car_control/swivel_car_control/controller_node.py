@@ -95,6 +95,7 @@ class ControllerNode(Node):
         self._command = SerializedMessage(ActuatorCommand(), (
             (STAMP_FORMAT, ('header.stamp.sec', 'header.stamp.nanosec')),
             ('<2d', ('swivel_torque', 'drive_speed'))))
+        self._answered_command = b''  # the command of the last state answered in full
         self._state = SwivelControllerState()
         self._limited = TwistStamped()
         self._limited.header.frame_id = self._base_frame_id
@@ -237,6 +238,14 @@ class ControllerNode(Node):
         if msg is None:
             return
         stamp = msg.stamp
+        if stamp_ns(stamp) == self._chain.last_ns:
+            # The lockstep sim republishes a state until its answer comes (every 100 ms of
+            # wall time): a copy that crossed the answer gets the same command again. Stepped
+            # twice on one moment, with a planner's command that came meanwhile for the next,
+            # the controller would publish another state of that moment, which the planner
+            # may tick on, and the run would depend on the machine's load.
+            self._command_pub.publish(self._answered_command)
+            return
         try:
             swivel, out = self._joint_states.answer(
                 stamp_to_seconds(stamp), msg.name, msg.position, msg.velocity)
@@ -253,6 +262,7 @@ class ControllerNode(Node):
             self.get_logger().warn('swivel_command timed out (planner gone?): released, drive '
                                    'stopped, swivel held')
         self._publish_command(stamp, out.swivel_torque, out.drive_speed)
+        self._answered_command = self._command.serialized()
 
         state = self._state
         state.header.stamp = stamp

@@ -292,6 +292,36 @@ def test_lockstep_waits_for_the_planners_command_of_the_previous_state():
         harness.close()
 
 
+def test_a_state_republished_after_its_answer_gets_the_same_command_and_no_new_state():
+    """
+    The lockstep sim republishes a state whose answer is late; a copy crossing the answer.
+
+    The planner's command for the next state may have come meanwhile: answered afresh, the
+    copy published a second controller state of that moment (target 0.4 against 0.3), which
+    the planner could tick on.
+    """
+    chain = PlannerChain(lockstep_wait=3.0)
+    harness, states = chain.harness, chain.states
+    try:
+        step(harness, 1.0)
+        chain.swivel.publish(stamped_swivel_command(1.0, 0.3))
+        chain.spin()
+        first = step(harness, 1.01, swivel=0.05)
+        assert chain.state_of(1.01).target == pytest.approx(0.3)
+        chain.swivel.publish(stamped_swivel_command(1.01, 0.4))  # the answer to 1.01
+        chain.spin()
+        again = step(harness, 1.01, swivel=0.05)  # the copy
+        assert again.swivel_torque == first.swivel_torque
+        assert again.drive_speed == first.drive_speed
+        chain.spin()
+        stamp = joint_state(1.01).header.stamp
+        assert [s.target for s in states if s.header.stamp == stamp] == [pytest.approx(0.3)]
+        step(harness, 1.02, swivel=0.05)  # the next state goes on
+        assert chain.state_of(1.02).target == pytest.approx(0.4)
+    finally:
+        harness.close()
+
+
 def test_after_lockstep_wait_the_controller_answers_without_the_planners_command():
     chain = PlannerChain(lockstep_wait=0.1)
     harness = chain.harness
