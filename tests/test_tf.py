@@ -51,6 +51,9 @@ ANGLE_TOLERANCE = 1e-3  # [rad]
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 TIMEOUT = 60.0  # [s] wall guard against a hang, not a measurement
+# [ns] of joint_states time between robot_description's /tf of the moving links (its default
+# publish_frequency, 20 Hz)
+LINKS_PERIOD_NS = 50_000_000
 FOXGLOVE = REPO_ROOT / 'tests' / 'foxglove'
 
 
@@ -269,13 +272,13 @@ def test_live_tf_and_a_recorded_bag_place_every_link(ros_domain, tmp_path):
         last = _ns(probe.joint_states[-1].header.stamp)
 
         def heard_up_to_last() -> bool:
-            # The odometry answers every state, robot_description every 50 ms of their time:
+            # The odometry answers every state, robot_description every LINKS_PERIOD_NS:
             # each has answered the last step once its latest /tf is that recent.
             latest = {}
             for m in probe.tf:
                 source = 'odom' if m.transforms[0].child_frame_id == 'base_link' else 'links'
                 latest[source] = max(latest.get(source, 0), _ns(m.transforms[0].header.stamp))
-            return latest.get('odom') == last and latest.get('links', 0) > last - 50_000_000
+            return latest.get('odom') == last and latest.get('links', 0) > last - LINKS_PERIOD_NS
         spin_until(executor, heard_up_to_last, TIMEOUT, '/tf of the last step')
         hashes = {(topic, i.node_name): str(i.topic_type_hash)
                   for topic in ('/tf', '/tf_static')
@@ -298,7 +301,7 @@ def test_live_tf_and_a_recorded_bag_place_every_link(ros_domain, tmp_path):
     assert [(t.header.frame_id, _ns(t.header.stamp)) for m in odom for t in m.transforms] \
         == [('odom', stamp) for stamp in stamps]
     links = [_ns(m.transforms[0].header.stamp) for m in tf if m not in odom]
-    assert np.diff(links).tolist() == [50_000_000] * (len(links) - 1)
+    assert np.diff(links).tolist() == [LINKS_PERIOD_NS] * (len(links) - 1)
     assert len(links) >= len(stamps) // 5 - 1
     live = {t.child_frame_id: t.header.frame_id for m in probe.tf_static + probe.tf
             for t in m.transforms}

@@ -227,11 +227,14 @@ class ControllerNode(Node):
                                        time.monotonic_ns()))
 
     def _publish_command(self, stamp: TimeMsg, swivel_torque: float,
-                         drive_speed: float) -> None:
+                         drive_speed: float) -> bytes:
+        """Publish one ActuatorCommand; return it serialized."""
         command = self._command
         command.pack(0, stamp.sec, stamp.nanosec)
         command.pack(1, swivel_torque, drive_speed)
-        self._command_pub.publish(command.serialized())
+        serialized = command.serialized()
+        self._command_pub.publish(serialized)
+        return serialized
 
     def _answer(self, msg: JointStateView | None) -> None:
         """One ActuatorCommand (and controller state) for this joint_states; None: none."""
@@ -261,8 +264,7 @@ class ControllerNode(Node):
         if out.swivel_command_timed_out:
             self.get_logger().warn('swivel_command timed out (planner gone?): released, drive '
                                    'stopped, swivel held')
-        self._publish_command(stamp, out.swivel_torque, out.drive_speed)
-        self._answered_command = self._command.serialized()
+        self._answered_command = self._publish_command(stamp, out.swivel_torque, out.drive_speed)
 
         state = self._state
         state.header.stamp = stamp

@@ -2,9 +2,11 @@
 
 import pytest
 from swivel_car_control.core.joint_states import check_swivel_reading, MAX_SWIVEL_RATE
+from swivel_car_sim.config import SimParameters
 from swivel_car_sim.physics import SwivelCarSim
 
-STEPS_PER_PERIOD = 5  # [1] physics steps of 2 ms in a 10 ms control period (sim_node.yaml)
+# [1] physics steps in a control period, as sim_node runs them
+STEPS_PER_PERIOD = round(SimParameters().control_period / SimParameters().time_step)
 
 
 @pytest.fixture(scope='module')
