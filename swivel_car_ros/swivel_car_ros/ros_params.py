@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import signal
+import typing
 from typing import Any, Callable, Collection, Mapping, TypeVar
 
 from builtin_interfaces.msg import Time
@@ -54,7 +55,11 @@ def declare_dataclass(node: Node, cls: type[T], given: Mapping[str, Any] | None 
     Declare one parameter per field of ``cls`` and build it from their values.
 
     The fields are ``swivel_car_model.description.described``: each one's default and
-    description (with its unit) are its parameter's, its validation the dataclass's.
+    description (with its unit) are its parameter's, its validation the dataclass's. A
+    parameter has its field's type: a ``float`` field's is dynamically typed, so that an
+    integer passes (``kp:=19``), and the dataclass checks it; a ``bool``, ``int`` or ``str``
+    field's is of that type (``max_misses:=3`` is the integer 3, ``use_stamped:=7`` is refused
+    naming it); another field's (a tuple of numbers) is dynamically typed, as a list.
 
     The fields in ``given`` (stated elsewhere) are not declared. All are read-only but the
     fields ``cls.LIVE`` names (if it has that class attribute), which its node applies while
@@ -64,20 +69,23 @@ def declare_dataclass(node: Node, cls: type[T], given: Mapping[str, Any] | None 
     ------
     ValueError
         The dataclass refuses the values; the message names the field.
+    ParameterException
+        A value of another type than its ``bool``, ``int`` or ``str`` field's.
 
     """
     values = dict(given or {})
     live = getattr(cls, 'LIVE', ())
+    types = typing.get_type_hints(cls)
     for field in dataclasses.fields(cls):
         if field.name in values:
             continue
-        default = field.default
-        if isinstance(default, int) and not isinstance(default, bool):
+        kind, default = types[field.name], field.default
+        if kind is float:
             default = float(default)
         value = node.declare_parameter(
             field.name, list(default) if isinstance(default, tuple) else default,
-            # Dynamic typing lets `kp:=19` (an integer) through; the dataclass validates.
-            ParameterDescriptor(description=field.metadata['description'], dynamic_typing=True,
+            ParameterDescriptor(description=field.metadata['description'],
+                                dynamic_typing=kind not in (bool, int, str),
                                 read_only=field.name not in live)).value
         values[field.name] = tuple(value) if isinstance(default, tuple) else value
     return cls(**values)

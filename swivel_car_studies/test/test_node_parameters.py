@@ -58,8 +58,9 @@ def declared(name: str, overrides: dict | None = None) -> dict:
 
 
 def _kind(value) -> type:
-    # A number is a number: declare_dataclass declares an integer field as a dynamically typed
-    # double (so that `kp:=19` passes), and the dataclass checks it.
+    # A number is a number: a float field's parameter is dynamically typed (so that `kp:=19`
+    # passes); an integer field's is an integer, and the node refuses a file's 3.0 for it
+    # (the last check of test_a_shipped_parameter_file_repeats_the_declared_defaults).
     return float if isinstance(value, int) and not isinstance(value, bool) else type(value)
 
 
