@@ -7,13 +7,11 @@ One ActuatorCommand per joint_states message (the lockstep protocol of docs/arch
 from __future__ import annotations
 
 import dataclasses
-import math
 import sys
 import time
 
 from builtin_interfaces.msg import Time as TimeMsg
 from geometry_msgs.msg import Twist, TwistStamped
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
@@ -21,6 +19,8 @@ from std_msgs.msg import Header
 from swivel_car_control.core.controller import ControllerConfig, SwivelController
 from swivel_car_control.core.joint_states import JointStateController
 from swivel_car_control.joints import MissingJointError
+from swivel_car_model.checks import check_number
+from swivel_car_model.description import described
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
 from swivel_car_ros.lockstep import ChainedAnswers, stamp_ns
 from swivel_car_ros.ros_params import (
@@ -34,6 +34,42 @@ _CLOCK_SLACK = 0.5  # [s]
 _NO_STAMP = TimeMsg()  # a source's stamp in the controller state while none was heard
 
 
+@dataclasses.dataclass(frozen=True)
+class ControllerNodeConfig:
+    """
+    What the node alone reads: its topics' types, frames and the lockstep chain's waits.
+
+    Each field's metadata ``description`` (with its unit) is also its ROS parameter's.
+
+    Raises
+    ------
+    ValueError
+        A field is of the wrong type or out of range; the message names it.
+
+    """
+
+    use_stamped: bool = described(True, 'cmd_vel is geometry_msgs/TwistStamped (true) or Twist')
+    base_frame_id: str = described('base_link', 'frame of ~/cmd_vel_out (REP-105 base_link)')
+    swivel_joint: str = described('swivel_joint', 'name of the swivel joint in joint_states')
+    lockstep_swivel_command: bool = described(
+        False, 'lockstep sim with a stamped swivel_command stream (the planner): answer each '
+        'joint_states only once the command answering the previous one has come, so climbs do '
+        'not depend on machine load')
+    lockstep_cmd_vel: bool = described(
+        False, 'lockstep sim with a driver that answers every state with a cmd_vel stamped '
+        "with it (a test or benchmark driver): wait for that cmd_vel as for the planner's "
+        'command; not for a teleop, which publishes at its own rate')
+    lockstep_wait: float = described(
+        0.05, 'longest wall-time wait for that command; then answer without it and wait no '
+        "more until the next command; keep it below the sim's lockstep_timeout [s]")
+
+    def __post_init__(self) -> None:
+        for name in ('base_frame_id', 'swivel_joint'):
+            if not isinstance(getattr(self, name), str) or not getattr(self, name):
+                raise ValueError(f'{name} must be a non-empty string')
+        check_number('lockstep_wait', self.lockstep_wait, above=0.0, unit='s')
+
+
 class ControllerNode(Node):
     """Event-driven swivel car controller; see the package README for its interface."""
 
@@ -43,52 +79,17 @@ class ControllerNode(Node):
         car = robot.model_params()
         config = declare_dataclass(self, ControllerConfig,
                                    given={'max_torque': robot.swivel_torque_limit})
-        self._use_stamped = self.declare_parameter(
-            'use_stamped', True, ParameterDescriptor(
-                description='cmd_vel is geometry_msgs/TwistStamped (true) or Twist',
-                read_only=True)).value
-        self._base_frame_id = self.declare_parameter(
-            'base_frame_id', 'base_link',
-            ParameterDescriptor(description='frame of ~/cmd_vel_out (REP-105 base_link)',
-                                read_only=True)).value
-        if not self._base_frame_id:
-            raise ValueError('base_frame_id must be a non-empty string')
-        swivel_joint = self.declare_parameter(
-            'swivel_joint', 'swivel_joint',
-            ParameterDescriptor(description='name of the swivel joint in joint_states',
-                                read_only=True)).value
-        self._lockstep_swivel_command = self.declare_parameter(
-            'lockstep_swivel_command', False, ParameterDescriptor(
-                description='lockstep sim with a stamped swivel_command stream (the planner): '
-                            'answer each joint_states only once the command answering the '
-                            'previous one has come, so climbs do not depend on machine '
-                            'load', read_only=True)).value
-        self._lockstep_cmd_vel = self.declare_parameter(
-            'lockstep_cmd_vel', False, ParameterDescriptor(
-                description='lockstep sim with a driver that answers every state with a '
-                            'cmd_vel stamped with it (a test or benchmark driver): wait for '
-                            "that cmd_vel as for the planner's command; not for a teleop, "
-                            'which publishes at its own rate', read_only=True)).value
-        self._lockstep_wait = self.declare_parameter(
-            'lockstep_wait', 0.05, ParameterDescriptor(
-                description='longest wall-time wait for that command; then answer without '
-                            'it and wait no more until the next command; keep it below the '
-                            "sim's lockstep_timeout [s]", dynamic_typing=True,
-                read_only=True)).value
-        if not (isinstance(self._lockstep_wait, (int, float))
-                and not isinstance(self._lockstep_wait, bool)
-                and math.isfinite(self._lockstep_wait) and self._lockstep_wait > 0.0):
-            raise ValueError(f'lockstep_wait must be > 0 s, got {self._lockstep_wait!r}')
+        self._node_config = node = declare_dataclass(self, ControllerNodeConfig)
         self._core = SwivelController(car, config)
         live_parameters(self, ControllerConfig.LIVE,
                         lambda changes: dataclasses.replace(self._core.config, **changes),
                         self._core.reconfigure)
-        self._joint_states = JointStateController(self._core, swivel_joint)
+        self._joint_states = JointStateController(self._core, node.swivel_joint)
         self._warned_zero_stamp = False
         # When to answer a joint_states in the lockstep chain: docs/architecture.md.
         self._chain: ChainedAnswers[JointStateView] = ChainedAnswers(
-            round(self._lockstep_wait * 1e9), self._lockstep_swivel_command,
-            self._lockstep_cmd_vel)
+            round(node.lockstep_wait * 1e9), node.lockstep_swivel_command,
+            node.lockstep_cmd_vel)
 
         # Built once, refilled every period: a message constructor imports and builds each
         # nested message in Python, every time; the command is rewritten in its CDR bytes.
@@ -98,7 +99,7 @@ class ControllerNode(Node):
         self._answered_command = b''  # the command of the last state answered in full
         self._state = SwivelControllerState()
         self._limited = TwistStamped()
-        self._limited.header.frame_id = self._base_frame_id
+        self._limited.header.frame_id = node.base_frame_id
         self._command_pub = self.create_publisher(ActuatorCommand, 'actuator_command',
                                                   STATE_QUEUE_DEPTH)
         self._state_pub = self.create_publisher(SwivelControllerState, '~/controller_state',
@@ -106,20 +107,20 @@ class ControllerNode(Node):
         self._cmd_out_pub = self.create_publisher(TwistStamped, '~/cmd_vel_out', 10)
         self.create_subscription(JointState, 'joint_states', self._on_joint_states, 10,
                                  raw=True)
-        self.create_subscription(TwistStamped if self._use_stamped else Twist, 'cmd_vel',
+        self.create_subscription(TwistStamped if node.use_stamped else Twist, 'cmd_vel',
                                  self._on_cmd_vel, 10)
         self.create_subscription(SwivelCommand, 'swivel_command', self._on_swivel_command, 10)
         self.create_subscription(Header, 'sim/reset_event', self._on_sim_reset, 10)
-        if self._lockstep_swivel_command or self._lockstep_cmd_vel:
-            self.create_timer(self._lockstep_wait / 4.0, self._on_wait_timer,
+        if node.lockstep_swivel_command or node.lockstep_cmd_vel:
+            self.create_timer(node.lockstep_wait / 4.0, self._on_wait_timer,
                               clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.get_logger().info(
             f'controller up: swivel limit {self._core.swivel_limit:.3f} rad (tip-safe), '
             f'kp={car.kp} ki={car.ki} kd={car.kd}, cmd_vel as '
-            f'{"TwistStamped" if self._use_stamped else "Twist"}, '
+            f'{"TwistStamped" if node.use_stamped else "Twist"}, '
             f'deadman {config.cmd_vel_timeout} s'
-            + (', lockstep with swivel_command' if self._lockstep_swivel_command else '')
-            + (', lockstep with cmd_vel' if self._lockstep_cmd_vel else ''))
+            + (', lockstep with swivel_command' if node.lockstep_swivel_command else '')
+            + (', lockstep with cmd_vel' if node.lockstep_cmd_vel else ''))
 
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9  # [s]
@@ -215,8 +216,8 @@ class ControllerNode(Node):
             names = ' or '.join(source.name for source in late)
             self.get_logger().warn(
                 f'no {names} answered the last state within lockstep_wait '
-                f'{self._lockstep_wait} s: going on without it until the next one comes '
-                '(the run is no longer deterministic)', throttle_duration_sec=5.0)
+                f'{self._node_config.lockstep_wait} s: going on without it until the next one '
+                'comes (the run is no longer deterministic)', throttle_duration_sec=5.0)
         self._answer(msg)
 
     def _on_joint_states(self, data: bytes) -> None:

@@ -13,7 +13,7 @@ answers (the service's response, an action goal's execution).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 import math
 import sys
 import threading
@@ -22,7 +22,6 @@ from typing import Callable
 
 from builtin_interfaces.msg import Time as TimeMsg
 from nav_msgs.msg import Odometry
-from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.action.server import ServerGoalHandle
 from rclpy.clock import Clock, ClockType
@@ -34,6 +33,7 @@ from sensor_msgs.msg import Imu
 from std_msgs.msg import Header
 from swivel_car_model import dynamics, kinematics
 from swivel_car_model.checks import check_number
+from swivel_car_model.description import described
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.msg import (
     ClimbOutcome, ClimbPlan, DetectedStep, SwivelCommand, SwivelControllerState)
@@ -49,7 +49,8 @@ from swivel_car_planner.core.liveness import ClimbSlot, InputLiveness
 from swivel_car_planner.core.sync import InputSync, Tick
 from swivel_car_ros.lockstep import ChainEntry, Entry
 from swivel_car_ros.ros_params import (
-    declare_description, moment_seconds, run_node, stamp_to_seconds)
+    declare_dataclass, declare_description, live_parameters, moment_seconds, run_node,
+    stamp_to_seconds)
 from swivel_car_ros.serialized import read_logged
 
 _CONTROLLER_STATE = inputs.CONTROLLER_STATE
@@ -145,35 +146,50 @@ class _PlanWorker:
             self._closed = True
 
 
+@dataclass(frozen=True)
+class PlannerNodeConfig:
+    """
+    The planner's settings outside the climb's: its capability table and input timeouts.
+
+    Each field's metadata ``description`` (with its unit) is also its ROS parameter's.
+
+    Raises
+    ------
+    ValueError
+        A timeout is not a finite number > 0; the message names it.
+
+    """
+
+    capability_file: str = described(
+        capability.INSTALLED, "the measured whole-car capability table (YAML); 'installed': the "
+        "package's config/capability.yaml; 'none': no table, only the model's limits")
+    ready_timeout: float = described(
+        1.0, 'inputs older than this (in sim and wall time) mean not ready; a climb whose inputs '
+        'stop for this long aborts [s]')
+    detection_max_age: float = described(
+        0.5, 'use_detected_step: the oldest detected_step a climb takes (the detector publishes '
+        'one per image) [s]')
+
+    def __post_init__(self) -> None:
+        for name in ('ready_timeout', 'detection_max_age'):
+            check_number(name, getattr(self, name), above=0.0)
+
+
 class PlannerNode(Node):
     """Serves ``climb_step`` (service and action); publishes ``swivel_command``."""
 
     def __init__(self, **kwargs) -> None:
         super().__init__('planner', **kwargs)
-        # The climb's settings apply from the next climb on; the rest is read-only. All
-        # dynamically typed, so that an integer where a number is due passes; the configs
-        # check the types.
-        self.config = PlannerConfig(**{
-            item.name: self.declare_parameter(
-                item.name, item.default, ParameterDescriptor(
-                    description=item.metadata['description'], dynamic_typing=True)).value
-            for item in fields(PlannerConfig)})
-        self.add_on_set_parameters_callback(self._check_config)
-        self.add_post_set_parameters_callback(self._apply_config)
+        # The climb's settings apply from the next climb on; the rest is read-only.
+        self.config = declare_dataclass(self, PlannerConfig)
+        live_parameters(self, PlannerConfig.LIVE,
+                        lambda changes: replace(self.config, **changes), self._apply_config)
         self.description = declare_description(self)
         self.robot = self.description.model_params()
-        self.whole_car_limit = self._load_capability(self.declare_parameter(
-            'capability_file', capability.INSTALLED, ParameterDescriptor(
-                description="the measured whole-car capability table (YAML); 'installed': "
-                            "the package's config/capability.yaml; 'none': no table, only "
-                            "the model's limits", read_only=True)).value)
-        self._ready_timeout = self._positive_parameter(
-            'ready_timeout', 1.0, 'inputs older than this (in sim and wall time) mean not '
-                                  'ready; a climb whose inputs stop for this long aborts [s]')
-
-        self._detected = DetectedSteps(self.description.wheelbase, self._positive_parameter(
-            'detection_max_age', 0.5, 'use_detected_step: the oldest detected_step a climb '
-                                      'takes (the detector publishes one per image) [s]'))
+        node = declare_dataclass(self, PlannerNodeConfig)
+        self.whole_car_limit = self._load_capability(node.capability_file)
+        self._ready_timeout = node.ready_timeout
+        self._detected = DetectedSteps(self.description.wheelbase, node.detection_max_age)
         self._slot: ClimbSlot[_ActiveClimb] = ClimbSlot()
         self._resets = 0  # sim/reset_events heard
         self._plans = _PlanWorker(self)
@@ -206,28 +222,9 @@ class PlannerNode(Node):
             f'planner ready: model max scalable step {self._max_step():.3f} m, torque limit '
             f'{self.robot.swivel_torque_limit:.1f} N m')
 
-    def _positive_parameter(self, name: str, default: float, description: str) -> float:
-        value = self.declare_parameter(name, default, ParameterDescriptor(
-            description=description, dynamic_typing=True, read_only=True)).value
-        return check_number(f'parameter {name}', value, above=0.0)
-
-    def _changed_config(self, parameters: list) -> PlannerConfig:
-        """Return the climb settings with ``parameters`` set; ValueError names a bad one."""
-        names = {item.name for item in fields(PlannerConfig)}
-        return replace(self.config, **{p.name: p.value for p in parameters if p.name in names})
-
-    def _check_config(self, parameters: list) -> SetParametersResult:
-        try:
-            self._changed_config(parameters)
-        except ValueError as error:
-            return SetParametersResult(successful=False, reason=str(error))
-        return SetParametersResult(successful=True)
-
-    def _apply_config(self, parameters: list) -> None:
-        config = self._changed_config(parameters)
-        if config != self.config:
-            self.config = config
-            self.get_logger().info('climb settings changed: they apply from the next climb')
+    def _apply_config(self, config: PlannerConfig) -> None:
+        """Take the climb settings ``config`` from the next climb on."""
+        self.config = config
 
     def _load_capability(self, value: str) -> float:
         """

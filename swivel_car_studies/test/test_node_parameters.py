@@ -16,6 +16,7 @@ import rclpy
 from rclpy.parameter import Parameter
 from swivel_car_control.controller_node import ControllerNode
 from swivel_car_control.odometry_node import OdometryNode
+from swivel_car_model.description import PARAMETERS as DESCRIPTION
 from swivel_car_perception.step_detector_node import StepDetectorNode
 from swivel_car_planner.planner_node import PlannerNode
 from swivel_car_ros.chain import CHAIN, ROS_ONLY
@@ -86,9 +87,13 @@ def test_a_node_declares_its_ros_only_parameters_and_the_stack_takes_the_others(
 def test_a_shipped_parameter_file_repeats_the_declared_defaults(name):
     # Every key is one the node declares, of the type of its default and equal to it (the
     # file documents the defaults; a change made in one place only fails here), and the node
-    # starts with the file's values.
+    # starts with the file's values. The file names every parameter of the node but rclpy's
+    # own, the robot description's (stated once, in swivel_car_model) and the sim's depth
+    # camera's (off by default; swivel_car_sim.depth_camera states them).
     defaults, values = declared(name), shipped(name)
     assert set(values) <= set(defaults), set(values) - set(defaults)
+    unnamed = set(defaults) - set(values) - {'use_sim_time'} - set(DESCRIPTION)
+    assert unnamed <= set(CAMERA_PARAMETERS) if name == 'sim' else not unnamed, unnamed
     for key, value in values.items():
         expected = SHIPPED_CHOICES.get(key, defaults[key])
         if isinstance(expected, tuple):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 import math
+from typing import ClassVar
 
 from swivel_car_model.checks import check_finite_number
 from swivel_car_model.description import described
@@ -113,6 +114,8 @@ class PlannerConfig:
     pitch_abort_margin: float = described(
         0.08, 'abort when the nose-up pitch comes this near the tip-over rule [rad]')
     time_allowance: float = described(60.0, 'default climb time limit, sim time [s]')
+    # Every field: each climb reads them from its start, so all may change while the node runs.
+    LIVE: ClassVar[tuple[str, ...]]
 
     def __post_init__(self) -> None:
         for item in fields(self):
@@ -133,3 +136,6 @@ class PlannerConfig:
         for name in ('max_step_yaw', 'max_lead_angle', 'push_lead'):
             if getattr(self, name) >= math.pi / 2:
                 raise ValueError(f'{name} must be below pi/2, got {getattr(self, name)!r}')
+
+
+PlannerConfig.LIVE = tuple(item.name for item in fields(PlannerConfig))
