@@ -66,7 +66,8 @@ $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	    --packages-ignore swivel_car_msgs & python_packages=$$!; }; \
 	MAKEFLAGS=-j$$(nproc) ../$(IN_WS) colcon build $(COLCON_BUILD_ARGS) \
 	    --base-paths src ../tf2_msgs --packages-select $(MSGS_PACKAGES) \
-	    --cmake-args -DBUILD_TESTING=OFF -DSWIVEL_CAR_MSGS_CPP=$(MSGS_CPP); msgs=$$?; \
+	    --cmake-args -DBUILD_TESTING=OFF -DSWIVEL_CAR_MSGS_CPP=$(MSGS_CPP) \
+	    -DSWIVEL_CAR_MSGS_UNITY_BUILD=ON; msgs=$$?; \
 	wait $$python_packages && exit $$msgs
 	touch $@
 

@@ -9,6 +9,34 @@ if(NOT SWIVEL_CAR_MSGS_CPP)
   list(FILTER AMENT_EXTENSIONS_rosidl_generate_idl_interfaces EXCLUDE REGEX "_cpp:")
 endif()
 
+# The C and C++ files rosidl generates, one per interface and typesupport, are compiled as one
+# file per library and core (CMake's unity build): each file of the Fast DDS typesupport parses
+# the same Fast CDR headers again. The generators' Python (rosidl_parser, empy) then takes most
+# of the build. Off by default, as colcon builds a package; `make build` turns it on. The type
+# description sources each define the same static names (one per referenced type), so they
+# stay files of their own.
+option(SWIVEL_CAR_MSGS_UNITY_BUILD "compile each interface library's sources as one" OFF)
+function(swivel_car_unity_build)
+  if(NOT SWIVEL_CAR_MSGS_UNITY_BUILD)
+    return()
+  endif()
+  get_property(targets DIRECTORY PROPERTY BUILDSYSTEM_TARGETS)
+  foreach(target IN LISTS targets)
+    get_target_property(type ${target} TYPE)
+    if(NOT type MATCHES "^(SHARED|MODULE|STATIC)_LIBRARY$")
+      continue()
+    endif()
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON)
+    get_target_property(sources ${target} SOURCES)
+    foreach(source IN LISTS sources)
+      if(source MATCHES "__description\\.c$")
+        set_source_files_properties(${source} TARGET_DIRECTORY ${target}
+          PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
+      endif()
+    endforeach()
+  endforeach()
+endfunction()
+
 # The ROS 2 wheels from PyPI were built in a manylinux container, and the CMake targets that
 # their message packages export (e.g. std_msgs::std_msgs__rosidl_generator_py) still name that
 # container's interpreter: /opt/python/cp311-cp311/include/python3.11 and its numpy include
