@@ -100,10 +100,17 @@ def _answer_later(service: Service) -> None:
     """
     Make ``service`` send what its callback returns, a Future of the response, once done.
 
-    rclpy has no deferred service response (rclcpp has had one since Humble), and Jazzy's
-    EventsExecutor takes no coroutine as a service callback (it hands the coroutine itself to
-    ``send_response``): both executors send what the callback returns through the service's
-    ``send_response``, and this one waits for the Future first.
+    rclpy has no deferred service response (rclcpp has had one since Humble). Its pattern, a
+    coroutine callback that awaits a Future, needs an executor that awaits the callback:
+    ``Executor._take_service`` does (executors.py: ``response = await
+    await_or_execute(srv.callback, ...)``), but Jazzy's EventsExecutor, which ``run_node``
+    gives, calls it and passes what it returns, the coroutine, to ``send_response``, which
+    raises TypeError (events_executor.cpp, ``HandleServiceReady``: ``response =
+    callback(request, res_type());`` then ``send_response(response, header);``; rolling awaits
+    it since ros2/rclpy#1478, not the rclpy 7.1.6 this stack pins). On the
+    SingleThreadedExecutor, which awaits it, the planner's system test takes a third more CPU.
+    Both executors look ``send_response`` up on the service for each request: this one, set on
+    the instance, waits for the Future first.
     """
     send = service.send_response
     service.send_response = lambda answered, header: answered.add_done_callback(
