@@ -242,12 +242,7 @@ class ControllerNode(Node):
         if msg is None:
             return
         stamp = msg.stamp
-        if stamp_ns(stamp) == self._chain.last_ns:
-            # The lockstep sim republishes a state until its answer comes (every 100 ms of
-            # wall time): a copy that crossed the answer gets the same command again. Stepped
-            # twice on one moment, with a planner's command that came meanwhile for the next,
-            # the controller would publish another state of that moment, which the planner
-            # may tick on, and the run would depend on the machine's load.
+        if self._chain.repeats(stamp_ns(stamp)):  # the sim's copy of the state answered
             self._command_pub.publish(self._answered_command)
             return
         try:

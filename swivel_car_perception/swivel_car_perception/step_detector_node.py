@@ -17,6 +17,7 @@ from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import ColorRGBA
+from swivel_car_model.checks import check_number
 from swivel_car_model.description import described
 from swivel_car_msgs.msg import DetectedStep
 from swivel_car_perception.core.detector import (
@@ -56,13 +57,10 @@ class StepDetectorConfig:
         if not isinstance(self.base_frame_id, str) or not self.base_frame_id:
             raise ValueError('base_frame_id must be a non-empty string')
         for name in ('min_height', 'max_distance', 'max_lateral', 'odom_drift', 'gate'):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                    or not math.isfinite(value) or value <= 0.0:
-                raise ValueError(f'{name} must be a number > 0, got {value!r}')
-        if isinstance(self.max_misses, bool) or not isinstance(self.max_misses, (int, float)) \
-                or self.max_misses < 0 or self.max_misses != int(self.max_misses):
-            raise ValueError(f'max_misses must be a whole number >= 0, got {self.max_misses!r}')
+            check_number(name, getattr(self, name), above=0.0)
+        check_number('max_misses', self.max_misses, at_least=0)
+        if not isinstance(self.max_misses, int):
+            raise ValueError(f'max_misses must be a whole number, got {self.max_misses!r}')
 
 
 class StepDetectorNode(Node):
@@ -78,7 +76,7 @@ class StepDetectorNode(Node):
             max_lateral=config.max_lateral)
         self._detector: StepDetector | None = None
         self._perception = StepPerception(None, StepTracker(
-            robot.wheelbase, config.odom_drift, config.gate, int(config.max_misses)))
+            robot.wheelbase, config.odom_drift, config.gate, config.max_misses))
         self._next_refusal: dict[str, float] = {}  # kind -> wall time [s] its next line is due
         self._step_pub = self.create_publisher(DetectedStep, 'detected_step', 10)
         self._marker_pub = self.create_publisher(MarkerArray, '~/markers', 10)

@@ -13,7 +13,7 @@ from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import CameraInfo, Image
 from swivel_car_msgs.msg import DetectedStep
 from swivel_car_perception.step_detector_node import (
-    IMAGE_TOPIC, INFO_TOPIC, StepDetectorNode)
+    IMAGE_TOPIC, INFO_TOPIC, StepDetectorConfig, StepDetectorNode)
 from swivel_car_testing import next_domain_id, spin_until
 from synthetic_scene import depth_image, INTRINSICS
 from visualization_msgs.msg import MarkerArray
@@ -74,6 +74,18 @@ class Rig:
         self.detector.destroy_node()
         self.client.destroy_node()
         rclpy.try_shutdown(context=self.context)
+
+
+@pytest.mark.parametrize('name, value, refusal', [
+    ('min_height', -0.01, 'min_height must be a finite number > 0'),
+    ('gate', float('nan'), 'gate must be a finite number > 0'),
+    ('odom_drift', True, 'odom_drift must be a finite number > 0'),
+    ('max_misses', -1, 'max_misses must be a finite number >= 0'),
+    ('max_misses', 2.5, 'max_misses must be a whole number'),
+    ('base_frame_id', '', 'base_frame_id must be a non-empty string')])
+def test_a_bad_setting_is_refused_naming_it(name, value, refusal):
+    with pytest.raises(ValueError, match=refusal):
+        StepDetectorConfig(**{name: value})
 
 
 @pytest.fixture(scope='module')

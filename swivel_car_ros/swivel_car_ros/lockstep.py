@@ -307,6 +307,18 @@ class ChainedAnswers(Generic[T]):
         """Note that the state of ``stamp_ns`` [ns] was answered in full (command and state)."""
         self.last_ns = stamp_ns
 
+    def repeats(self, stamp_ns: int) -> bool:
+        """
+        Tell whether the state of ``stamp_ns`` [ns] is the one last answered in full.
+
+        The lockstep sim publishes a state again until its answer comes (every
+        ``REPUBLISH_PERIOD_NS`` of wall time): a copy that crossed the answer gets the same
+        command again, and nothing else. Answered anew, with a planner's command for the next
+        state come meanwhile, it would give another controller state of that moment, which
+        the planner may tick on, and the run would depend on the machine's load.
+        """
+        return stamp_ns == self.last_ns
+
     def forget(self, reset_ns: int) -> None:
         """Forget the old world's pending state and commands: a sim reset at ``reset_ns``."""
         if self._pending is not None and self._pending_ns < reset_ns:

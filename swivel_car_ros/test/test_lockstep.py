@@ -136,11 +136,16 @@ class Controller:
         self.chain = ChainedAnswers(50 * MS, swivel_command, cmd_vel)
         self.holding = False
         self.answers = []
+        self.repeated = []  # states answered again with the same command, and nothing else
 
     def answer(self, state):
-        if state is not None:
-            self.chain.answered(state)
-            self.answers.append(state)
+        if state is None:
+            return
+        if self.chain.repeats(state):
+            self.repeated.append(state)
+            return
+        self.chain.answered(state)
+        self.answers.append(state)
 
     def state(self, t, now_ns=0):
         self.answer(self.chain.state(t, t, self.holding, now_ns))
@@ -176,8 +181,21 @@ def test_a_held_stamped_swivel_command_makes_the_next_state_wait_for_its_answer(
     assert c.tick(50 * MS) == [] and c.answers[-1] == 2 * PERIOD  # not yet late
     c.swivel_command(2 * PERIOD)
     assert c.answers[-1] == 3 * PERIOD
-    c.state(3 * PERIOD)  # a republished state already answered: answered again
-    assert c.answers[-1] == 3 * PERIOD and len(c.answers) == 4
+    c.state(3 * PERIOD)  # a republished state already answered: its command again
+    assert c.answers == [PERIOD, 2 * PERIOD, 3 * PERIOD] and c.repeated == [3 * PERIOD]
+
+
+def test_a_state_republished_after_its_answer_gets_its_command_again_and_nothing_more():
+    c = planner_chained()
+    c.state(3 * PERIOD, now_ns=0)
+    c.swivel_command(2 * PERIOD)  # the state of 3 is answered
+    c.swivel_command(3 * PERIOD)  # and the planner's answer to it comes, for the next
+    # The sim published 3 again before the answer reached it: the copy comes after both.
+    c.state(3 * PERIOD, now_ns=REPUBLISH_PERIOD_NS + 1)
+    assert c.answers == [PERIOD, 2 * PERIOD, 3 * PERIOD] and c.repeated == [3 * PERIOD]
+    c.state(4 * PERIOD, now_ns=REPUBLISH_PERIOD_NS + 2)  # the next moment: a new answer
+    assert c.answers[-1] == 4 * PERIOD and c.repeated == [3 * PERIOD]
+    assert not c.chain.repeats(3 * PERIOD) and c.chain.repeats(4 * PERIOD)
 
 
 def test_a_command_for_another_state_does_not_release_the_wait():
