@@ -44,11 +44,13 @@ BUILD_INPUTS := $(shell find swivel_car_* tf2_msgs -type f -not -path '*/__pycac
     -o -path '*/msg/*' -o -path '*/srv/*' -o -path '*/action/*' -o -path '*/config/*' \
     -o -path '*/launch/*' -o -path '*/resource/*' \))
 
-# Two jobs side by side, since the interfaces' generators and compilers leave a core mostly
-# idle: the interfaces, and the Python packages, which need them only at run time (colcon would
-# otherwise wait for them). The interfaces compile a job per core whatever the load average
-# (colcon adds make's -l<cores>): after a busy minute, the load alone made them compile one
-# file at a time (53 s instead of 34 s for the package alone).
+# Three jobs side by side, since the interfaces' generators and compilers leave a core mostly
+# idle: the interfaces; the Python packages, which need them only at run time (colcon would
+# otherwise wait for them); and the byte code of the installed modules the tests import
+# (scripts/warm_bytecode.py), which the test workers and their nodes would otherwise each
+# compile at once, at the start of make test. The interfaces compile a job per core whatever
+# the load average (colcon adds make's -l<cores>): after a busy minute, the load alone made
+# them compile one file at a time (53 s instead of 34 s for the package alone).
 COLCON_BUILD_ARGS := --symlink-install --event-handlers console_cohesion- summary+
 
 $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
@@ -62,13 +64,14 @@ $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	cd ros2_ws && ../$(IN_WS) python -c 'from colcon_core.verb import check_and_mark_build_tool \
 	    as build, check_and_mark_install_layout as install; build("build"); \
 	    install("install", merge_install=False)'
-	cd ros2_ws && { ../$(IN_WS) colcon --log-base log/python_packages build $(COLCON_BUILD_ARGS) \
+	cd ros2_ws && { ../$(IN_WS) python ../scripts/warm_bytecode.py & warm_bytecode=$$!; } && \
+	{ ../$(IN_WS) colcon --log-base log/python_packages build $(COLCON_BUILD_ARGS) \
 	    --packages-ignore swivel_car_msgs & python_packages=$$!; }; \
 	MAKEFLAGS=-j$$(nproc) ../$(IN_WS) colcon build $(COLCON_BUILD_ARGS) \
 	    --base-paths src ../tf2_msgs --packages-select $(MSGS_PACKAGES) \
 	    --cmake-args -DBUILD_TESTING=OFF -DSWIVEL_CAR_MSGS_CPP=$(MSGS_CPP) \
 	    -DSWIVEL_CAR_MSGS_UNITY_BUILD=ON; msgs=$$?; \
-	wait $$python_packages && exit $$msgs
+	wait $$python_packages && wait $$warm_bytecode && exit $$msgs
 	touch $@
 
 # Test files run side by side, one pytest-xdist worker more than cores (PYTEST_WORKERS=0: in
