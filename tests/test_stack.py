@@ -60,10 +60,10 @@ NODES = {'sim': ('swivel_car_sim', 'sim_node'),
 UP_LOGS = {'controller': 'controller up', 'odometry': 'odometry up', 'planner': 'planner ready'}
 # After this many wall seconds without a command the sim takes the controller for gone and
 # runs on at real time with its watchdog (a killed controller); the controller waits half
-# of it for the planner and this test's driver. At 3 s, a full `make test` once held this
-# node up longer than the 1.5 s wait: the controller went on without the driver, took its
-# release 0.36 s of sim time late, and the car stopped that much later than the deadman
-# test allows (1.19 s against 0.9; 0.83 s whenever the chain holds, every time).
+# of it for the planner and this test's driver. Long enough that a loaded machine never holds
+# this test's node up beyond the controller's wait: the controller would go on without the
+# driver, take its release late in sim time, and the car would stop that much later than
+# the deadman test allows.
 LOCKSTEP_TIMEOUT = 6.0  # [s], as sim_session.py
 # Messages the test keeps per topic: 10 s of sim time, so an unpaced sim that runs ahead of
 # the test's node (nothing holds it while no one drives) loses none of them on the way.
@@ -73,16 +73,12 @@ CONTROL_PERIOD = 0.01  # [s] sim_node.yaml
 # (max_linear_acceleration 1 m/s^2) then takes to stop the car from 0.3 m/s.
 DEADMAN = 0.5  # [s]
 BRAKING = 0.3  # [s]
-# Fast DDS 2.14 now and then leaves a participant that joins a running domain unmatched, for
-# good, with one already there, either way. Measured here: a sim killed and started again every
-# few seconds next to one or two long-running listeners; in 18 of 184 starts a listener had not
-# heard it 25 s later, though its graph listed the new sim's publishers (stopping the sim
-# gracefully, 1 of 17, or keeping its old ports from reuse, 4 of 44, did not help), while 60
-# first starts in fresh domains were all heard; eProsima/Fast-DDS#3822 reports the same of
-# late joiners. In CI runs a new sim was once never heard by this test's node (perhaps the race
-# a paused start now avoids, see restart), once never heard the controller. A node not heard
-# within this long of wall time after its start, a new sim that hears no controller, or a
-# planner deaf to the stack this long, is started once more: a new process joins afresh.
+# Fast DDS 2.14 can leave a participant that joins a running domain unmatched for good with
+# one already there, either way; first starts in fresh domains are not affected
+# (eProsima/Fast-DDS#3822 reports the same of late joiners); stopping the old node gracefully
+# or keeping its ports from reuse does not prevent it. A node not heard within this long of
+# wall time after its start, a new sim that hears no controller, or a planner deaf to the
+# stack this long, is therefore started once more: a new process joins afresh.
 REJOIN_AFTER = 10.0  # [s]
 
 

@@ -43,8 +43,8 @@ def test_a_detected_step_is_climbed_with_all_four_wheels_on_top():
         seen = detections[-1]
         # The action, for its feedback. The detector runs outside the lockstep chain: under
         # load the planner may have taken no detection yet, or only one older than
-        # detection_max_age (a full make test once held the detector 0.7 s of sim time
-        # behind). Refused then, nothing moved: asked again.
+        # detection_max_age (a loaded machine holds the detector back by more than that).
+        # Refused then, nothing moved: asked again.
         feedback = []
         for _ in range(20):
             response = _climb_detected(session, feedback)
