@@ -6,7 +6,8 @@ A flake hunt: ``make test-repeat RUNS=5 HOG=1`` (or ``scripts/in_ws python
 scripts/test_repeat.py --runs 5 --hog``). Each run is ``make test``'s pytest command; with
 ``--hog`` one process keeps one core busy throughout, as another job on the machine would.
 Prints a line per run, each test that failed with how often, and a summary line; the exit code
-is 0 only if every run was green.
+is 0 only if every run was green. The JUnit reports of red runs (every failure in full, with
+the nodes' logs the system tests attach) are kept in a directory it names.
 """
 
 import argparse
@@ -64,25 +65,31 @@ def main() -> int:
     hog = subprocess.Popen([sys.executable, '-c', HOG]) if args.hog else None
     failures: collections.Counter[str] = collections.Counter()
     green = 0
+    reports = Path(tempfile.mkdtemp(prefix='swivel-car-test-repeat-'))
     try:
-        with tempfile.TemporaryDirectory() as directory:
-            for run in range(1, args.runs + 1):
-                report = Path(directory) / f'run{run}.xml'
-                code, seconds = run_once(args.workers, args.pytest_args, report)
-                failed = failed_tests(report) if code else []
-                if code and not failed:
-                    failed = [f'(pytest exit code {code}, no failed test reported)']
-                failures.update(failed)
-                green += not failed
-                print(f'run {run}/{args.runs}: {"green" if not failed else "RED"} in '
-                      f'{seconds:.0f} s' + ''.join(f'\n  failed: {t}' for t in failed),
-                      flush=True)
+        for run in range(1, args.runs + 1):
+            report = reports / f'run{run}.xml'
+            code, seconds = run_once(args.workers, args.pytest_args, report)
+            failed = failed_tests(report) if code else []
+            if code and not failed:
+                failed = [f'(pytest exit code {code}, no failed test reported)']
+            failures.update(failed)
+            green += not failed
+            if not failed:
+                report.unlink(missing_ok=True)
+            print(f'run {run}/{args.runs}: {"green" if not failed else "RED"} in '
+                  f'{seconds:.0f} s' + ''.join(f'\n  failed: {t}' for t in failed),
+                  flush=True)
     finally:
         if hog is not None:
             hog.kill()
             hog.wait()
     for test, count in failures.most_common():
         print(f'{count} of {args.runs} runs failed: {test}')
+    if any(reports.iterdir()):
+        print(f'JUnit reports of the red runs: {reports}')
+    else:
+        reports.rmdir()
     load = 'with one core busy' if args.hog else 'without load'
     print(f'{green} of {args.runs} runs green ({load}); {len(failures)} tests failed at least '
           'once')
