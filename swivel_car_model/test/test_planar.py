@@ -215,7 +215,7 @@ def test_wheel_rate_for_speed():
 
 # --- the tabulated model against the exact one ----------------------------------------------
 # The bounds TabulatedModel's docstring states; the odometry's own error on the benchmark
-# routes is 0.04-0.7 % of the distance, so 1e-6 relative in the twist is far below it.
+# routes is 0.04-0.7 % of the distance, so a few 1e-6 relative in the twist is far below it.
 
 def test_tabulated_geometry_is_the_exact_geometry_over_the_whole_swivel_range():
     # 4000 angles, none on a table sample but the last: the worst case lies between samples.
@@ -242,9 +242,9 @@ def test_tabulated_twist_and_curvature_match_the_exact_ones(p):
         rate, wheel_rate = rng.uniform(-2.0, 2.0), rng.uniform(-8.0, 8.0)
         v, omega = planar.body_twist(p, theta2, rate, wheel_rate)
         scale = abs(v) + abs(omega)
-        # Not the docstring's 1e-6 relative: over 12,000 angles (uniform and random, 0.01 rad
-        # around 0 included) with random rates, on this test's geometries and phi -pi/3 with
-        # the default h and r, the linear table's twist is within 2.7e-6 of |v| + |omega| (a
+        # Over 12,000 angles (uniform and random, 0.01 rad around 0 included) with random
+        # rates, on this test's geometries and phi -pi/3 with the default h and r, the linear
+        # table's twist is within 2.7e-6 of |v| + |omega| (a
         # component near zero is off by more than 1e-6 of itself), its curvature within
         # 4.4e-6 relative where |curvature| > 1e-3 1/m and 5.4e-9 1/m below; about x4 margin.
         # Still 20 times below the odometry's own error on the benchmark routes.
