@@ -513,7 +513,9 @@ class Stack:
             self.truth[-1].twist.twist.linear.x > 0.1
             and self.controller_states[-1].source == 'swivel_command'
             and self.controller_states[-1].drive_speed > 0.0), 60.0, 'the climb to drive')
-        assert not climb.done(), climb.result().message
+        # What each node said is the only trace of why a climb ended before it drove.
+        assert not climb.done(), (
+            f'{climb.result().message}\n{process_report(self.processes.values())}')
         self.kill(name)
         return climb
 
