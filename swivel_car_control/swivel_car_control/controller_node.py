@@ -19,7 +19,7 @@ from std_msgs.msg import Header
 from swivel_car_control.core.controller import ControllerConfig, SwivelController
 from swivel_car_control.core.joint_states import JointStateController
 from swivel_car_control.joints import MissingJointError
-from swivel_car_model.checks import check_number
+from swivel_car_model.checks import check_nonempty_string, check_number
 from swivel_car_model.description import described
 from swivel_car_msgs.msg import ActuatorCommand, SwivelCommand, SwivelControllerState
 from swivel_car_ros.lockstep import ChainedAnswers, stamp_ns
@@ -65,8 +65,7 @@ class ControllerNodeConfig:
 
     def __post_init__(self) -> None:
         for name in ('base_frame_id', 'swivel_joint'):
-            if not isinstance(getattr(self, name), str) or not getattr(self, name):
-                raise ValueError(f'{name} must be a non-empty string')
+            check_nonempty_string(name, getattr(self, name))
         check_number('lockstep_wait', self.lockstep_wait, above=0.0, unit='s')
 
 

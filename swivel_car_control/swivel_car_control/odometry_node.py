@@ -23,6 +23,7 @@ from swivel_car_control.core.joint_states import (
     JointStateOdometry, MAX_SWIVEL_RATE, yaw_quaternion, YAW_RATE_SOURCES)
 from swivel_car_control.core.odometry_input import GatedOdometry, Verdict, WHEEL_RATE_FACTOR
 from swivel_car_control.joints import MissingJointError
+from swivel_car_model.checks import check_nonempty_string
 from swivel_car_model.description import described
 from swivel_car_msgs.srv import SetPose2D
 from swivel_car_ros.ros_params import (
@@ -71,8 +72,7 @@ class OdometryConfig:
             raise ValueError(f'publish_rate must be > 0 Hz, got {self.publish_rate!r}')
         for name in ('odom_frame_id', 'base_frame_id', 'swivel_joint', 'rear_left_wheel_joint',
                      'rear_right_wheel_joint'):
-            if not isinstance(getattr(self, name), str) or not getattr(self, name):
-                raise ValueError(f'{name} must be a non-empty string')
+            check_nonempty_string(name, getattr(self, name))
         for name in ('pose_covariance_diagonal', 'twist_covariance_diagonal'):
             values = getattr(self, name)
             if len(values) != 6 or not all(

@@ -62,3 +62,17 @@ def check_finite_number(name: str, value: Any) -> None:
 
     """
     check_number(name, value)
+
+
+def check_nonempty_string(name: str, value: Any) -> None:
+    """
+    Refuse anything but a non-empty str (a frame id, a joint name).
+
+    Raises
+    ------
+    ValueError
+        ``<name> must be a non-empty string``.
+
+    """
+    if not isinstance(value, str) or not value:
+        raise ValueError(f'{name} must be a non-empty string')

@@ -11,7 +11,7 @@ import math
 from bad_values import assert_refusal_names, at_most, NOT_A_FINITE_NUMBER
 from hypothesis import given, strategies as st
 import pytest
-from swivel_car_model.checks import check_finite_number, check_number
+from swivel_car_model.checks import check_finite_number, check_nonempty_string, check_number
 from swivel_car_model.description import CarDescription
 from swivel_car_model.params import SwivelCarParams
 
@@ -47,6 +47,13 @@ def test_check_number_refuses_a_bad_value_in_one_line_naming_the_field(bad, boun
 def test_check_number_with_allow_inf_takes_inf_and_returns_a_float(good):
     value = check_number('integral_band', good, above=0.0, allow_inf=True)
     assert value == good and type(value) is float
+
+
+@pytest.mark.parametrize('bad', ['', None, 0, b'base_link', ['base_link']])
+def test_check_nonempty_string_refuses_anything_but_a_nonempty_str(bad):
+    with pytest.raises(ValueError, match='^base_frame_id must be a non-empty string$'):
+        check_nonempty_string('base_frame_id', bad)
+    check_nonempty_string('base_frame_id', 'base_link')
 
 
 @given(name=st.sampled_from(PARAMS_FIELDS), bad=NOT_A_FINITE_NUMBER)

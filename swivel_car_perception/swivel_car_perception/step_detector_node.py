@@ -17,7 +17,7 @@ from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import ColorRGBA
-from swivel_car_model.checks import check_number
+from swivel_car_model.checks import check_nonempty_string, check_number
 from swivel_car_model.description import described
 from swivel_car_msgs.msg import DetectedStep
 from swivel_car_perception.core.detector import (
@@ -54,8 +54,7 @@ class StepDetectorConfig:
         3, 'frames without a detection before the fused estimate is dropped [1]')
 
     def __post_init__(self) -> None:
-        if not isinstance(self.base_frame_id, str) or not self.base_frame_id:
-            raise ValueError('base_frame_id must be a non-empty string')
+        check_nonempty_string('base_frame_id', self.base_frame_id)
         for name in ('min_height', 'max_distance', 'max_lateral', 'odom_drift', 'gate'):
             check_number(name, getattr(self, name), above=0.0)
         check_number('max_misses', self.max_misses, at_least=0)

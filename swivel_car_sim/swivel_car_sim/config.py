@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import math
 
 from swivel_car_model import description
-from swivel_car_model.checks import check_finite_number
+from swivel_car_model.checks import check_finite_number, check_nonempty_string
 from swivel_car_model.description import described
 from swivel_car_sim.physics import SimConfig
 from swivel_car_sim.sensor_models import SensorProfile
@@ -153,8 +153,7 @@ class SimNodeConfig:
             elif not isinstance(value, str):
                 raise ValueError(f'{name} must be a string, got {value!r}')
         for name in ('world_frame_id', 'base_frame_id'):
-            if not v[name]:
-                raise ValueError(f'{name} must be a non-empty string')
+            check_nonempty_string(name, v[name])
         if v['clock_source'] not in CLOCK_SOURCES:
             raise ValueError(f"clock_source must be 'sim' or 'wall', got {v['clock_source']!r}")
         if v['clock_source'] == 'wall':
