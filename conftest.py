@@ -13,13 +13,22 @@ deadline: an example's wall time depends on the machine's load (one took 414 ms 
 default 200 ms with three test processes on two cores).
 
 The files pytest.ini names in ``run_first`` are collected first, in that order.
+
+Every participant of the test processes, and of the nodes they start (which inherit the
+environment), reads tests/support/fastdds_test_profile.xml: under the suite's load the
+default socket buffers dropped datagrams (Udp RcvbufErrors), and a reliable topic then
+stalled until Fast DDS's next heartbeat, 3 s later by default.
 """
 
 import importlib
 import os
+from pathlib import Path
 
 from hypothesis import settings
 import pytest
+
+os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(
+    Path(__file__).resolve().parent / 'tests' / 'support' / 'fastdds_test_profile.xml')
 
 for package in ('swivel_car_control', 'swivel_car_model', 'swivel_car_perception',
                 'swivel_car_planner', 'swivel_car_ros', 'swivel_car_sim', 'swivel_car_studies',
