@@ -40,6 +40,7 @@ TARGET_RTF = 10.0  # [1] issue 15
 # ahead), and only a known width keeps the path on the face.
 STEP_WIDTH = 3.0
 CLIMB_WALL_LIMIT = 300.0  # [s] guard against a hung stack, not a measurement
+REQUEST_RETRY = 3.0  # [s] wall: a readiness request unanswered this long is asked again
 
 
 def run_time(pid: int) -> float:
@@ -86,8 +87,20 @@ class Client:
         spin_until(self.executor, lambda: self.spawn.service_is_ready()
                    and self.climb.service_is_ready(), timeout, 'the services')
         deadline = time.monotonic() + timeout
-        while self.call(self.climb, ClimbStep.Request(step_height=10.0, step_distance=1.0),
-                        timeout).error_code == ClimbStep.Response.ERROR_NOT_READY:
+        while True:
+            # A request can go unanswered: the server is ready to this client once it has
+            # matched the request topic, maybe before its answers reach the client (once the
+            # second climb's wait ran out after 60 s). Unanswered in 3 s, it is asked again.
+            future = self.climb.call_async(
+                ClimbStep.Request(step_height=10.0, step_distance=1.0))
+            retry = time.monotonic() + REQUEST_RETRY
+            spin_until(self.executor, lambda: future.done() or time.monotonic() > retry,
+                       REQUEST_RETRY + 30.0, 'a refusal')
+            if future.done() and \
+                    future.result().error_code != ClimbStep.Response.ERROR_NOT_READY:
+                return
+            if not future.done():
+                self.climb.remove_pending_request(future)
             if time.monotonic() > deadline:
                 raise TimeoutError('the planner never got ready')
             self.executor.spin_once(timeout_sec=0.2)

@@ -1,10 +1,12 @@
 import dataclasses
 
 import pytest
+from scipy.stats import beta
 
 from swivel_car_model.description import CarDescription
 
-from swivel_car_planner.core.capability import CapabilityTable, description_values
+from swivel_car_planner.core.capability import (
+    CapabilityTable, description_values, lower_bound)
 
 
 def table(successes, trials=8, description=None):
@@ -34,6 +36,17 @@ def test_with_a_confidence_the_limit_is_where_the_lower_bound_stays_reliable():
     few = CapabilityTable((0.02,), (8,), (8,), description_values(CarDescription()),
                           reliable=0.85, confidence=0.9)
     assert few.limit == 0.0
+
+
+@pytest.mark.parametrize('successes, trials', [(1, 1), (1, 8), (7, 8), (8, 8), (37, 40),
+                                               (199, 200)])
+@pytest.mark.parametrize('confidence', [0.5, 0.9, 0.99])
+def test_the_lower_bound_is_the_beta_quantile_of_clopper_pearson(successes, trials, confidence):
+    # Two routes to one number (the regularized incomplete beta function's inverse): equal
+    # to a few units in the last place, far inside any use of the bound.
+    assert lower_bound(successes, trials, confidence) == pytest.approx(
+        beta.ppf(1.0 - confidence, successes, trials - successes + 1), rel=1e-12)
+    assert lower_bound(0, trials, confidence) == 0.0
 
 
 def test_the_table_round_trips_through_its_file(tmp_path):

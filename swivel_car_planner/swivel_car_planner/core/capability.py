@@ -31,7 +31,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from scipy.stats import beta
+from scipy.special import betaincinv
 from swivel_car_model.description import CarDescription
 import yaml
 
@@ -154,7 +154,9 @@ def lower_bound(successes: int, trials: int, confidence: float) -> float:
     """
     if successes == 0:
         return 0.0
-    return float(beta.ppf(1.0 - confidence, successes, trials - successes + 1))
+    # The (1 - confidence) quantile of Beta(successes, trials - successes + 1), from
+    # scipy.special: scipy.stats would add a quarter of a second of CPU to every planner start.
+    return float(betaincinv(successes, trials - successes + 1, 1.0 - confidence))
 
 
 def description_values(description: CarDescription) -> dict[str, Any]:
