@@ -28,8 +28,8 @@ __all__ = ['config_path', 'executable_path', 'INSTALL_DIR', 'lockstep_parameters
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
 # stragglers are never heard. Every process (a pytest-xdist worker, another pytest, the
 # benchmark) claims a block of ten ids of its own with a lock file on this host, held until it
-# exits; the search starts at a block chosen by the pid, so a block left by a process that
-# just ended (perhaps with stragglers) is rarely the next one taken.
+# exits; the search starts at a block chosen by the pid, and skips a block on which a live
+# process still runs (a node a killed test run left: it would talk to this run's nodes).
 _BLOCKS = 23  # ROS_DOMAIN_ID 1 .. 230 (Fast DDS allows at most 232)
 _LOCK_DIR = Path(tempfile.gettempdir()) / 'swivel_car_ros_domains'
 _held: list[IO[str]] = []
@@ -85,11 +85,32 @@ def resume_sim(executor: Any, set_paused: Any, timeout: float = 60.0) -> None:
     set_paused.call_async(SetBool.Request(data=False))
 
 
+def domains_in_use(proc: Path = Path('/proc')) -> set[int]:
+    """Return the ROS_DOMAIN_IDs in the environments of the live processes we may read."""
+    domains = set()
+    for process in proc.iterdir():
+        if not process.name.isdigit():
+            continue
+        try:
+            environment = (process / 'environ').read_bytes()
+        except OSError:
+            continue  # ended meanwhile, or not ours to read
+        for entry in environment.split(b'\0'):
+            if entry.startswith(b'ROS_DOMAIN_ID='):
+                value = entry.removeprefix(b'ROS_DOMAIN_ID=')
+                if value.isdigit():
+                    domains.add(int(value))
+    return domains
+
+
 def _claim_block() -> int:
     remove_unborn_shm_ports()
     _LOCK_DIR.mkdir(exist_ok=True)
+    in_use = domains_in_use()
     for k in range(_BLOCKS):
         block = (os.getpid() + k) % _BLOCKS
+        if in_use.intersection(range(1 + 10 * block, 11 + 10 * block)):
+            continue
         lock = open(_LOCK_DIR / f'{block}.lock', 'w')
         try:
             fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)

@@ -1,0 +1,37 @@
+"""
+The test support's ROS domain blocks: a block a live process still runs on is not claimed.
+
+A node left running by a killed test run (kill -9 of pytest does not reach the nodes it
+started, which run in sessions of their own) keeps talking on its domain; a new run's node on
+the same domain would hear two sims.
+"""
+
+import os
+from pathlib import Path
+import subprocess
+import sys
+
+import swivel_car_testing
+
+
+def test_the_domains_of_live_processes_are_found_and_an_ended_ones_are_not():
+    leftover = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(60)'],
+                                env={**os.environ, 'ROS_DOMAIN_ID': '57'})
+    try:
+        assert 57 in swivel_car_testing.domains_in_use()
+    finally:
+        leftover.kill()
+        leftover.wait()
+    assert 57 not in swivel_car_testing.domains_in_use()
+
+
+def test_a_block_with_a_live_process_on_one_of_its_domains_is_skipped(tmp_path, monkeypatch):
+    block = os.getpid() % swivel_car_testing._BLOCKS  # the block this process would try first
+    monkeypatch.setattr(swivel_car_testing, '_LOCK_DIR', Path(tmp_path))
+    monkeypatch.setattr(swivel_car_testing, 'remove_unborn_shm_ports', lambda: [])
+    monkeypatch.setattr(swivel_car_testing, 'domains_in_use', lambda: {10 * block + 7})
+    claimed = swivel_car_testing._claim_block()
+    try:
+        assert claimed == (block + 1) % swivel_car_testing._BLOCKS
+    finally:
+        swivel_car_testing._held.pop().close()
