@@ -51,6 +51,8 @@ STEP_DISTANCE = 1.0  # [m] from the front axle after the drive: the planner's ro
 # machine (timed out in APPROACH): a weakness of the stack under CPU starvation, not of this test.
 STEP_WIDTH = 3.0
 START_TIMEOUT = 90.0  # [s] wall: four processes starting on a loaded machine
+DRIVE_DISTANCE = 0.3  # [m] driven by cmd_vel before the climb
+DRIVE_TIMEOUT = 30.0  # [s] wall: a guard against a stack that does not drive (1 s idle)
 CLIMB_TIMEOUT = 180.0  # [s] wall: the planner's time allowance is 60 s of (wall) time
 
 
@@ -101,20 +103,24 @@ def test_drive_by_cmd_vel_then_climb_a_5_cm_step_on_the_system_clock(hardware_st
     assert abs(stamp.sec + stamp.nanosec * 1e-9 - time.time()) < 5.0
 
     start = GroundTruth.from_msg(truth[-1])
-    until = time.monotonic() + 1.5  # [s] wall: the robot's time
-    while time.monotonic() < until:
+    # cmd_vel until the car has driven DRIVE_DISTANCE, not for a fixed time: how far a second
+    # of wall time takes it depends on the load (a controller starved of CPU answers late, and
+    # the sim's watchdog drops a command that late), which is not what this test is about.
+    give_up = time.monotonic() + DRIVE_TIMEOUT
+    while GroundTruth.from_msg(truth[-1]).x - start.x < DRIVE_DISTANCE:
+        assert time.monotonic() < give_up, (
+            f'driven {GroundTruth.from_msg(truth[-1]).x - start.x:.3f} m in {DRIVE_TIMEOUT} s'
+            f'\n{process_report(processes, 4000)}')
         message = TwistStamped()
         message.header.stamp = node.get_clock().now().to_msg()
         message.twist.linear.x = 0.3  # [m/s]
         cmd_vel.publish(message)
         spin_until(executor, lambda n=len(truth): alive() or len(truth) > n + 4, 30.0,
                    'ground truth while driving')
-    stopped = len(truth)
-    spin_until(executor, lambda: alive() or len(truth) > stopped + 100, 30.0,
-               'the car to stop (cmd_vel deadman)')
+    # Released: the cmd_vel deadman stops the car, which then stands for the climb's plan.
+    spin_until(executor, lambda: alive() or GroundTruth.from_msg(truth[-1]).speed < 0.01,
+               30.0, 'the car to stop (cmd_vel deadman)')
     driven = GroundTruth.from_msg(truth[-1])
-    # 0.3 m/s for 1.5 s less the ramps: at least 0.2 m, however late the answers.
-    assert driven.x - start.x > 0.2, (start, driven)
 
     p = SwivelCarParams()
     spawned = spawn.call_async(SpawnObstacle.Request(obstacle=StepObstacle(
