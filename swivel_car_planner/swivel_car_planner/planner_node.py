@@ -72,6 +72,7 @@ class _ActiveClimb:
     answer: Callable[[_Result], None]  # takes the result once the climb has ended
     goal_handle: ServerGoalHandle | None = None
     use_detected_step: bool = False  # follows the detector's edge during the approach
+    requested_at: float = -math.inf  # [s] node clock at the request (see _reset_since)
     machine: ClimbStateMachine = field(init=False)
     entry: ChainEntry = field(default_factory=ChainEntry)  # its way into the chain
     first_command: Command | None = None  # stands for each tick until the entry engages
@@ -199,6 +200,7 @@ class PlannerNode(Node):
         self._detected = DetectedSteps(self.description.wheelbase, node.detection_max_age)
         self._slot: ClimbSlot[_ActiveClimb] = ClimbSlot()
         self._resets = 0  # sim/reset_events heard
+        self._reset_stamp = -math.inf  # [s] the newest one's: the first state of its world
         self._plans = _PlanWorker(self)
         self._liveness = InputLiveness(_INPUTS, self._ready_timeout)
         self._sync = InputSync(_INPUTS, _CONTROLLER_STATE)
@@ -372,21 +374,26 @@ class PlannerNode(Node):
                 answer(self._failure(ErrorCode.BUSY,
                                      'a climb is already being planned or running'))
                 return
-        resets = self._resets
+        resets, requested_at = self._resets, self._now()
 
         def planned(future: Future) -> None:
-            result = self._planned(request, future, resets, answer, goal_handle,
-                                   use_detected_step)
+            result = self._planned(request, future, (resets, requested_at), answer,
+                                   goal_handle, use_detected_step)
             if result is not None:
                 answer(result)
 
         self._plans.plan(self.robot, self.config, request, self.whole_car_limit
                          ).add_done_callback(planned)
 
-    def _planned(self, request: ClimbRequest, planned: Future, resets: int,
-                 answer: Callable[[_Result], None], goal_handle: ServerGoalHandle | None,
+    def _planned(self, request: ClimbRequest, planned: Future,
+                 requested: tuple[int, float], answer: Callable[[_Result], None],
+                 goal_handle: ServerGoalHandle | None,
                  use_detected_step: bool = False) -> _Result | None:
-        """Return the result of a finished planning; None when the climb has started."""
+        """
+        Return the result of a finished planning; None when the climb has started.
+
+        ``requested``: the sim/reset_events heard and the node clock [s] at the request.
+        """
         if not request.plan_only:
             self._slot.planned(None)
         try:
@@ -398,13 +405,14 @@ class PlannerNode(Node):
                            plan_to_msg(plan), ClimbOutcome())
         if goal_handle is not None and goal_handle.is_cancel_requested:
             return self._failure(ErrorCode.CANCELED, 'canceled while planning: nothing moved')
-        if self._resets != resets:
+        resets, requested_at = requested
+        if self._resets != resets and self._reset_since(self._reset_stamp, requested_at):
             return self._failure(ErrorCode.NOT_READY, 'the sim was reset while the climb was '
                                  'planned: nothing moved, ask again in the new world')
         climb = _ActiveClimb(
             lambda: ClimbStateMachine(self.robot, self.config, plan, request.step_distance,
                                       request.step_yaw, request.time_allowance),
-            plan, answer, goal_handle, use_detected_step)
+            plan, answer, goal_handle, use_detected_step, requested_at)
         # The climb starts from the moments after its planning (seconds, when a backup is
         # searched): a tick of the inputs collected before would be that old.
         self._sync.clear()
@@ -416,6 +424,19 @@ class PlannerNode(Node):
             f'swivel {plan.swivel_angle:.3f} rad, approach heading '
             f'{plan.approach_heading:.3f} rad')
         return None
+
+    @staticmethod
+    def _reset_since(reset_stamp: float, requested_at: float) -> bool:
+        """
+        Tell whether a sim reset heard after a climb's request came after the request.
+
+        ``reset_stamp``: the reset event's (its world's first state) [s]; ``requested_at``:
+        the node clock at the request [s]. A reset event can be heard after the request
+        although the world was reset before it: the event travels on a topic of its own, and
+        a /clock of the new world, heard first, had already dated the request there (a client
+        that reset the sim and then asked). That climb goes on.
+        """
+        return reset_stamp >= requested_at
 
     def _failure(self, code: ErrorCode, message: str) -> _Result:
         self.get_logger().warning(f'climb_step refused ({code.name}): {message}')
@@ -496,11 +517,12 @@ class PlannerNode(Node):
         controller, reset by the same event, holds the swivel where it measures it then with
         the drive stopped; the usual stop would hold the swivel at the old world's angle.
         """
-        self._resets += 1
-        climb = self._slot.climb
-        if climb is None:
-            return
         stamp = stamp_to_seconds(msg.stamp)  # [s]
+        self._resets += 1
+        self._reset_stamp = stamp
+        climb = self._slot.climb
+        if climb is None or not self._reset_since(stamp, climb.requested_at):
+            return
         climb.machine.abort(ErrorCode.NOT_READY,
                             f'the sim was reset at {stamp:.2f} s: the climb does not go on in '
                             f'the reset world')

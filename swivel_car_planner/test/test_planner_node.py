@@ -542,15 +542,19 @@ def test_a_goal_canceled_while_planned_never_moves(rig, held_plans):
     assert rig.received == []
 
 
-def publish_reset_event(rig):
-    """As the sim's reset: the event names the next state, the first of the new world."""
+def publish_reset_event(rig, cycles=None):
+    """
+    As the sim's reset: the event names the next state, the first of the new world.
+
+    ``cycles``: the control cycle of that state (default: the next one).
+    """
     publisher = rig.node.create_publisher(Header, 'sim/reset_event', 10)
     spin_until(rig.executor, lambda: publisher.get_subscription_count() > 0, 10.0,
                'the planner on sim/reset_event')
-    stamp = rig.car.time
-    publisher.publish(Header(stamp=rclpy.time.Time(nanoseconds=rig.car.cycles * 10**7).to_msg(),
+    cycles = rig.car.cycles if cycles is None else cycles
+    publisher.publish(Header(stamp=rclpy.time.Time(nanoseconds=cycles * 10**7).to_msg(),
                              frame_id='world'))
-    return stamp
+    return cycles * 0.01  # [s]
 
 
 def test_a_sim_reset_ends_the_climb_with_the_car_stopped(rig):
@@ -585,6 +589,28 @@ def test_a_sim_reset_while_planned_ends_the_climb_before_it_moves(rig, held_plan
     assert response.error_code == ErrorCode.NOT_READY
     assert 'reset' in response.message
     assert rig.received == []
+
+
+def test_a_reset_event_heard_late_from_before_the_request_does_not_end_the_climb(
+        rig, held_plans):
+    # A client reset the sim, saw the new world and asked; the planner heard /clock of the new
+    # world before the request, and the reset event (its own topic) only while planning.
+    climb = start_held_climb(rig, held_plans, lambda: rig.call(**SUCCESSFUL_CLIMB))
+    publish_reset_event(rig, cycles=rig.car.cycles - 20)
+    rig.warm_up(cycles=5)
+    held_plans.release()
+    response = rig.drive(climb)
+    assert response.success, response.message
+
+
+def test_a_reset_event_heard_late_from_before_the_request_does_not_end_a_running_climb(rig):
+    rig.warm_up()
+    requested = rig.car.cycles
+    future = rig.call(**SUCCESSFUL_CLIMB)
+    rig.drive(_Deadline(rig, 1.0))
+    publish_reset_event(rig, cycles=requested - 20)
+    response = rig.drive(future)
+    assert response.success, response.message
 
 
 class _Deadline:
