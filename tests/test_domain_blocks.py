@@ -15,14 +15,15 @@ import swivel_car_testing
 
 
 def test_the_domains_of_live_processes_are_found_and_an_ended_ones_are_not():
+    # 9999: no ROS process uses it (Fast DDS takes 0..232; other test workers' nodes use 1..230).
     leftover = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(60)'],
-                                env={**os.environ, 'ROS_DOMAIN_ID': '57'})
+                                env={**os.environ, 'ROS_DOMAIN_ID': '9999'})
     try:
-        assert 57 in swivel_car_testing.domains_in_use()
+        assert 9999 in swivel_car_testing.domains_in_use()
     finally:
         leftover.kill()
         leftover.wait()
-    assert 57 not in swivel_car_testing.domains_in_use()
+    assert 9999 not in swivel_car_testing.domains_in_use()
 
 
 def test_a_block_with_a_live_process_on_one_of_its_domains_is_skipped(tmp_path, monkeypatch):
