@@ -304,7 +304,17 @@ class ChainedAnswers(Generic[T]):
         return self._take(), late
 
     def answered(self, stamp_ns: int) -> None:
-        """Note that the state of ``stamp_ns`` [ns] was answered in full (command and state)."""
+        """
+        Note that the state of ``stamp_ns`` [ns] was answered in full (command and state).
+
+        One before the last answered is a restarted sim's new world (its clock from 0): the
+        sources' commands were the old world's, forgotten as at a reset. Kept, a driver's
+        stamp of the old world would be reported as its answer in the new one, and waited for
+        again once the new world's clock passed it.
+        """
+        if self.last_ns is not None and stamp_ns < self.last_ns:
+            self.planner.forget()
+            self.driver.forget()
         self.last_ns = stamp_ns
 
     def repeats(self, stamp_ns: int) -> bool:

@@ -297,6 +297,22 @@ def test_a_sim_reset_forgets_the_old_worlds_state_and_commands():
     assert c.chain.tick(c.holding, 10_000 * MS) == (6 * PERIOD, [])
 
 
+def test_a_restarted_sim_forgets_the_old_worlds_commands():
+    c = planner_chained()
+    c.cmd_vel(2 * PERIOD)  # the driver answers the state of 2 as well
+    c.state(3 * PERIOD)
+    c.swivel_command(3 * PERIOD, hold=False)  # released: only the driver is waited for
+    assert c.answers[-1] == 3 * PERIOD and c.chain.driver.heard_ns == 2 * PERIOD
+    c.state(1 * PERIOD)  # a new sim, its clock from 0 again: answered, nothing awaited
+    assert c.answers[-1] == PERIOD
+    assert c.chain.driver.heard_ns == 0 and not c.chain.driver.chained
+    assert c.chain.planner.heard_ns == 0 and not c.chain.planner.chained
+    # Past the old world's stamps, nothing old is waited for.
+    for k in range(2, 5):
+        c.state(k * PERIOD)
+    assert c.answers[-3:] == [2 * PERIOD, 3 * PERIOD, 4 * PERIOD]
+
+
 def test_the_last_stamped_command_is_kept_in_the_callers_form_until_a_reset():
     chain = ChainedAnswers(50 * MS, True, True)
     stamp = Time(sec=1, nanosec=10)
