@@ -29,7 +29,7 @@ from rclpy.executors import SingleThreadedExecutor
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand
 from swivel_car_msgs.srv import ClimbStep, SpawnObstacle
 from swivel_car_stack import (
-    config_path, lockstep_parameters, NodeProcess, spin_until, start_node)
+    config_path, lockstep_parameters, NodeProcess, ResentRequest, spin_until, start_node)
 import yaml
 
 NODES = (('swivel_car_sim', 'sim_node'), ('swivel_car_control', 'controller_node'),
@@ -40,7 +40,7 @@ TARGET_RTF = 10.0  # [1] issue 15
 # ahead), and only a known width keeps the path on the face.
 STEP_WIDTH = 3.0
 CLIMB_WALL_LIMIT = 300.0  # [s] guard against a hung stack, not a measurement
-REQUEST_RETRY = 3.0  # [s] wall: a readiness request unanswered this long is asked again
+REQUEST_RETRY = 3.0  # [s] wall: a readiness request unanswered this long is sent again
 
 
 def run_time(pid: int) -> float:
@@ -88,19 +88,14 @@ class Client:
                    and self.climb.service_is_ready(), timeout, 'the services')
         deadline = time.monotonic() + timeout
         while True:
-            # A request can go unanswered: the server is ready to this client once it has
-            # matched the request topic, maybe before its answers reach the client (once the
-            # second climb's wait ran out after 60 s). Unanswered in 3 s, it is asked again.
-            future = self.climb.call_async(
-                ClimbStep.Request(step_height=10.0, step_distance=1.0))
-            retry = time.monotonic() + REQUEST_RETRY
-            spin_until(self.executor, lambda: future.done() or time.monotonic() > retry,
-                       REQUEST_RETRY + 30.0, 'a refusal')
-            if future.done() and \
-                    future.result().error_code != ClimbStep.Response.ERROR_NOT_READY:
+            # Resent: the first answer once went missing and the second climb's wait ran out
+            # after 60 s.
+            call = ResentRequest(self.climb, ClimbStep.Request(step_height=10.0,
+                                                               step_distance=1.0),
+                                 REQUEST_RETRY)
+            spin_until(self.executor, call.done, timeout, 'a refusal')
+            if call.result().error_code != ClimbStep.Response.ERROR_NOT_READY:
                 return
-            if not future.done():
-                self.climb.remove_pending_request(future)
             if time.monotonic() > deadline:
                 raise TimeoutError('the planner never got ready')
             self.executor.spin_once(timeout_sec=0.2)

@@ -198,6 +198,34 @@ def lockstep_parameters(executable: str, lockstep_timeout: float,
     return {}
 
 
+class ResentRequest:
+    """
+    A service request sent again every ``resend_after`` wall seconds [s] until one is answered.
+
+    For a request that may come twice. A server that has not yet discovered the client's
+    response reader drops the response (rclpy logs "failed to send response ... (timeout)"),
+    though the client already sees the service ready; under load that window outlasted the
+    discovery waits. Spin until ``done()``, then take ``result()``.
+    """
+
+    def __init__(self, client: Any, request: Any, resend_after: float) -> None:
+        self._client, self._request, self._resend_after = client, request, resend_after
+        self._start = time.monotonic()  # [s]
+        self._futures = [client.call_async(request)]
+
+    def done(self) -> bool:
+        """Tell whether one copy is answered; send another when one is due."""
+        if any(future.done() for future in self._futures):
+            return True
+        if time.monotonic() > self._start + self._resend_after * len(self._futures):
+            self._futures.append(self._client.call_async(self._request))
+        return False
+
+    def result(self) -> Any:
+        """Return the response of the first copy answered."""
+        return next(future for future in self._futures if future.done()).result()
+
+
 def spin_until(executor: Any, condition: Callable[[], bool], timeout: float,
                what: str = 'condition') -> None:
     """

@@ -10,6 +10,7 @@ ground truth. Processes come from the repository's scripts/swivel_car_stack.py.
 from __future__ import annotations
 
 import itertools
+import math
 import os
 from pathlib import Path
 import sys
@@ -35,7 +36,8 @@ except ImportError:  # outside pytest: the repository's helpers (pytest.ini puts
     _REPO = Path(__file__).resolve().parents[2]
     sys.path += [str(_REPO / 'scripts'), str(_REPO / 'tests' / 'support')]
     from swivel_car_testing import next_domain_id, spin_until
-from swivel_car_stack import lockstep_parameters, NodeProcess, process_report, start_node
+from swivel_car_stack import (
+    lockstep_parameters, NodeProcess, process_report, ResentRequest, start_node)
 
 CLIMB_WALL_LIMIT = 600.0  # [s] guard against a hung stack, not a measurement
 # [s] wall; half of it the controller waits for the planner. A loaded CI machine held a
@@ -178,22 +180,11 @@ class SimSession:
         Return the service's response.
 
         ``resend``: for a request that may come twice, sent again every ``RESEND_AFTER`` wall
-        seconds until one is answered. A server that has not yet discovered this client's
-        response reader drops the response (rclpy logs "failed to send response ...
-        (timeout)"); under load that window outlasted the discovery waits.
+        seconds until one is answered (``ResentRequest``).
         """
-        start = time.monotonic()
-        futures = [client.call_async(request)]
-
-        def answered() -> bool:
-            if any(f.done() for f in futures):
-                return True
-            if resend and time.monotonic() > start + RESEND_AFTER * len(futures):
-                futures.append(client.call_async(request))
-            return False
-
-        self.spin_until(answered, timeout, f'{client.srv_name}')
-        return next(f for f in futures if f.done()).result()
+        call = ResentRequest(client, request, RESEND_AFTER if resend else math.inf)
+        self.spin_until(call.done, timeout, f'{client.srv_name}')
+        return call.result()
 
     def reset(self, x: float = 0.0, y: float = 0.0, yaw: float = 0.0) -> None:
         """
