@@ -323,6 +323,32 @@ def test_without_a_width_the_approach_only_holds_its_heading():
     assert make_plan(P, CONFIG, request(0.05)).crossing is None
 
 
+@pytest.mark.parametrize('height', [0.03, 0.05, 0.07])
+@pytest.mark.parametrize('yaw', [-0.2, 0.0, 0.2])
+def test_on_a_wide_face_the_crossing_is_where_turning_at_once_on_the_aligning_arc_leads(
+        height, yaw):
+    # Planned on an instant turn, the line lay beside where the car's turn ends (8.8 cm for
+    # 5 cm at 1 m, square): the approach chased it into the lift point, up to max_steer off
+    # its heading, and met the lift point off the heading on a loaded machine.
+    distance = 1.0  # [m] front axle to the edge along x, as the hardware-time test asks
+    plan = make_plan(P, STANDARD, request(height, distance=distance, yaw=yaw, width=4.0))
+    assert plan.procedure == PROCEDURE_ACTIVE_LIFT and plan.backup_distance == 0.0
+    assert plan.reposition == ()
+    # The car's frame: base_link (the rear axle) at the origin, heading along x; the edge
+    # through (wheelbase + distance, 0) with its normal at ``yaw``. base_link turns on the
+    # aligning arc (radius wheelbase / tan(max_steer)) to the approach heading, then straight.
+    radius = P.wheelbase / math.tan(STANDARD.max_steer)  # [m]
+    final = yaw + plan.approach_heading  # [rad] in the car's frame
+    side = math.copysign(1.0, final)
+    start = np.array([radius * math.sin(abs(final)), side * radius * (1.0 - math.cos(final))])
+    edge_point = np.array([P.wheelbase + distance, 0.0])
+    normal = np.array([math.cos(yaw), math.sin(yaw)])
+    direction = np.array([math.cos(final), math.sin(final)])
+    crossing = start + direction * (normal @ (edge_point - start)) / (normal @ direction)
+    along = (crossing - edge_point) @ np.array([-math.sin(yaw), math.cos(yaw)])  # leftwards
+    assert plan.crossing == pytest.approx(along, abs=1e-9)  # closed forms, both
+
+
 @pytest.mark.parametrize('yaw, offset', [(0.0, -0.6), (0.3, -0.6), (-0.3, 0.6), (0.0, -1.0)])
 def test_the_crossing_keeps_every_wheel_on_the_top_face(yaw, offset):
     width = 1.5

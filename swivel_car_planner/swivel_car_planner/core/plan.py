@@ -436,9 +436,12 @@ def _placed(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest, si
 
     At the lift the lifted wheel's rest contact is ``lead_distance`` and the front axle's
     centre ``axle_normal`` short of the edge. The result says whether there is room to align,
-    and where the car crosses the edge. ``turn_first``: aim at the crossing the car reaches by
-    turning onto ``heading`` at once on its tightest arc (the push-lift's large heading; a
-    crossing that assumes an instant turn leaves the car chasing its line at the lift point).
+    and where the car crosses the edge: where it gets by turning onto ``heading`` at once on
+    its aligning arc, if the face allows. A crossing that assumed an instant turn left the car
+    beside its line after the turn (8.8 cm for a 5 cm step 1 m ahead), chasing it at up to
+    ``max_steer`` off the planned heading into the lift point. ``turn_first``: the crossings
+    reachable are those of turning at once or later on that arc (the push-lift's and the
+    semi-active approach's large headings), not those of an instant turn.
     """
     psi_lead = advance.end_heading
 
@@ -458,8 +461,9 @@ def _placed(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest, si
     if request.step_width > 0.0:
         low, high = crossing_range(p, config, request, psi_lead)
         # Where base_link's line crosses the edge: turning to the approach heading at once
-        # gives ``now``; holding today's heading until the last turn and lift gives ``late``;
-        # any crossing between is reachable by choosing when to turn.
+        # gives ``now`` (on the aligning arc: ``turned``); holding today's heading until the
+        # last turn and lift gives ``late``; any crossing between is reachable by choosing
+        # when to turn.
         back = p.wheelbase + request.step_distance  # [m] base_link to the edge along x
         along, normal = back * math.sin(request.step_yaw), back * math.cos(request.step_yaw)
         initial = -request.step_yaw  # [rad] heading to the normal now
@@ -468,13 +472,13 @@ def _placed(p: SwivelCarParams, config: PlannerConfig, request: ClimbRequest, si
         arc = turn_radius * abs(math.sin(heading) - math.sin(initial))  # [m] along normal
         swing = math.copysign(turn_radius * abs(math.cos(initial) - math.cos(heading)),
                               heading - initial)  # [m] the arc along the edge
-        now = (along + swing + (normal - arc) * math.tan(heading) if turn_first
-               else along + normal * math.tan(heading))
+        turned = along + swing + (normal - arc) * math.tan(heading)
+        now = turned if turn_first else along + normal * math.tan(heading)
         final = axle_normal + p.wheelbase * math.cos(heading)  # [m]
         late = (along + max(0.0, normal - arc - final) * math.tan(initial) + swing
                 + min(normal, final) * math.tan(heading))
         reachable = (min(now, late), max(now, late))
-        crossing = min(high, max(low, now))
+        crossing = min(high, max(low, turned))
         nearest = min(reachable[1], max(reachable[0], crossing))
         shift = abs(crossing - nearest)
         room = reachable[1] - reachable[0]
