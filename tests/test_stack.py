@@ -112,7 +112,12 @@ class Stack:
         self.release_stamp = Time()  # the last release's stamp (zero: unstamped)
         self.unanswered: deque[SwivelControllerState] = deque(maxlen=QUEUE)
         self.odom_time: float | None = None  # [s] of the running odometry's last odom
-        self.user.create_subscription(Odometry, 'ground_truth/odom', self._on_truth, QUEUE)
+        self._truth_subscription = self.user.create_subscription(
+            Odometry, 'ground_truth/odom', self._on_truth, QUEUE)
+        # The fewest sims the truth subscription was matched with since the last sim was
+        # started (a killed one stays matched until its lease runs out): the new one is
+        # matched once there are more.
+        self._sims_matched_floor = 0
         self.user.create_subscription(Odometry, 'odom', self._on_odom, QUEUE)
         self.user.create_subscription(Header, 'sim/reset_event', self.resets.append, 10)
         self.user.create_subscription(SwivelControllerState, 'controller/controller_state',
@@ -218,6 +223,8 @@ class Stack:
         pause = name in UP_LOGS and 'sim' in self.processes
         if pause:
             self.pause_sim(True)
+        if name == 'sim':  # the old one, if still matched: the new one cannot be yet
+            self._sims_matched_floor = self._truth_subscription.get_publisher_count()
         self.processes[name] = self.start(name, paused=name == 'sim')
         if pause:
             self.processes[name].wait_for_output(UP_LOGS[name], 60.0)
@@ -248,10 +255,14 @@ class Stack:
 
     def _resuming(self, heard: Callable[[], bool]) -> Callable[[], bool]:
         """
-        Return ``heard``, which asks the sim to resume, again every second, until it is true.
+        Return ``heard``, which asks the new sim to resume, again every second, until it is true.
 
-        A server that has not yet matched this node's client drops the request unanswered;
-        asked again, a sim running already runs on.
+        Only once this node's ground truth subscription has matched the new sim: its service
+        can match first, and the sim then ran unheard, held by nothing (this node answers a
+        state once it has the odometry's, and the controller waits for no silent driver),
+        past the old sim's clock before this node heard it (123 s of sim time in 11 s wall,
+        once). A server that has not yet matched this node's client drops the request
+        unanswered; asked again, a sim running already runs on.
         """
         asked = -math.inf  # [s] wall
 
@@ -259,7 +270,9 @@ class Stack:
             nonlocal asked
             if heard():
                 return True
-            if time.monotonic() - asked > 1.0:
+            matched = self._truth_subscription.get_publisher_count()
+            self._sims_matched_floor = min(self._sims_matched_floor, matched)
+            if matched > self._sims_matched_floor and time.monotonic() - asked > 1.0:
                 self.set_paused.call_async(SetBool.Request(data=False))
                 asked = time.monotonic()
             return False
