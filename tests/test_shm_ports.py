@@ -7,6 +7,7 @@ removes them before a process's first domain (swivel_car_testing.remove_unborn_s
 
 from pathlib import Path
 
+import pytest
 from swivel_car_testing import next_domain_id, NodeProcess, remove_unborn_shm_ports
 
 
@@ -30,15 +31,24 @@ def test_only_unborn_ports_that_no_process_holds_are_removed(tmp_path):
 def test_a_node_whose_port_was_left_unborn_starts_once_it_is_removed():
     # Without the removal the node waits forever inside rclpy's Node() (checked by hand: no
     # 'controller up' in 10 s; with it, under a second).
-    domain_id = next_domain_id()
-    # Participant 0's discovery and user ports (Fast DDS port rules).
-    ports = [Path(f'/dev/shm/fastrtps_port{7400 + 250 * domain_id + offset}')
-             for offset in (10, 11)]
+    # Participant 0's discovery and user ports (Fast DDS port rules), made unborn only in a
+    # domain where neither exists: written over, a live participant's port is corrupted for
+    # good (not all zeros, so never removed), and the next participant 0 of that domain hung
+    # in Node() for 70 minutes, an hour after this test had done so in a make test-repeat run.
+    for _ in range(10):  # next_domain_id's ten
+        domain_id = next_domain_id()
+        ports = [Path(f'/dev/shm/fastrtps_port{7400 + 250 * domain_id + offset}')
+                 for offset in (10, 11)]
+        if not any(port.exists() for port in ports):
+            break
+    else:
+        pytest.fail("participant 0's ports exist in all of this process's domains")
     for port in ports:
-        port.write_bytes(bytes(52400))
+        with port.open('xb') as file:  # never over a port that appeared meanwhile
+            file.write(bytes(52400))
     remove_unborn_shm_ports()
     # Gone, whoever removed them: another test worker claiming its first domain removes
-    # unborn ports too, and took one of these first in one of five make test runs.
+    # unborn ports too.
     assert not any(port.exists() for port in ports)
     node = NodeProcess('swivel_car_control', 'controller_node', domain_id, {})
     try:
