@@ -34,6 +34,7 @@ from swivel_car_model.params import SwivelCarParams
 from swivel_car_msgs.msg import StepObstacle
 from swivel_car_msgs.srv import ClimbStep, SpawnObstacle
 from swivel_car_planner.ground_truth import GroundTruth
+from swivel_car_ros.ros_params import stamp_to_seconds
 from swivel_car_stack import process_report, spin_until, start_node
 from swivel_car_testing import next_domain_id
 
@@ -61,13 +62,12 @@ STANDING_TIME = 0.5  # [s] of ground-truth stamps below STANDING_SPEED: the car 
 
 def standing(truth: list[Odometry]) -> bool:
     """Tell whether every ground truth of the last STANDING_TIME is below STANDING_SPEED."""
-    def seconds(message: Odometry) -> float:
-        return message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
-
-    if not truth or seconds(truth[-1]) - seconds(truth[0]) < STANDING_TIME:
+    if not truth or (stamp_to_seconds(truth[-1].header.stamp)
+                     - stamp_to_seconds(truth[0].header.stamp)) < STANDING_TIME:
         return False
-    since = seconds(truth[-1]) - STANDING_TIME
-    recent = [m for m in truth[-200:] if seconds(m) >= since]  # 200: 2 s at 100 Hz
+    since = stamp_to_seconds(truth[-1].header.stamp) - STANDING_TIME
+    recent = [m for m in truth[-200:]  # 200: 2 s at 100 Hz
+              if stamp_to_seconds(m.header.stamp) >= since]
     return all(GroundTruth.from_msg(m).speed < STANDING_SPEED for m in recent)
 
 
@@ -114,8 +114,7 @@ def test_drive_by_cmd_vel_then_climb_a_5_cm_step_on_the_system_clock(hardware_st
                                              and cmd_vel.get_subscription_count() > 0),
                START_TIMEOUT, 'the stack')
     # Stamps of the system clock, as the robot's.
-    stamp = truth[-1].header.stamp
-    assert abs(stamp.sec + stamp.nanosec * 1e-9 - time.time()) < 5.0
+    assert abs(stamp_to_seconds(truth[-1].header.stamp) - time.time()) < 5.0
 
     start = GroundTruth.from_msg(truth[-1])
     # cmd_vel until the car has driven DRIVE_DISTANCE, not for a fixed time: how far a second

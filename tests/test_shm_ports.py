@@ -33,8 +33,8 @@ def test_a_node_whose_port_was_left_unborn_starts_once_it_is_removed():
     # 'controller up' in 10 s; with it, under a second).
     # Participant 0's discovery and user ports (Fast DDS port rules), made unborn only in a
     # domain where neither exists: written over, a live participant's port is corrupted for
-    # good (not all zeros, so never removed), and the next participant 0 of that domain hung
-    # in Node() for 70 minutes, an hour after this test had done so in a make test-repeat run.
+    # good (not all zeros, so never removed), and every later participant 0 of that domain
+    # hangs in Node().
     for _ in range(10):  # next_domain_id's ten
         domain_id = next_domain_id()
         ports = [Path(f'/dev/shm/fastrtps_port{7400 + 250 * domain_id + offset}')
