@@ -16,13 +16,18 @@ import swivel_car_testing
 
 def test_the_domains_of_live_processes_are_found_and_an_ended_ones_are_not():
     # 9999: no ROS process uses it (Fast DDS takes 0..232; other test workers' nodes use 1..230).
-    leftover = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(60)'],
-                                env={**os.environ, 'ROS_DOMAIN_ID': '9999'})
+    # Until the child has run its own program, /proc shows the environment it was forked with,
+    # this process's: it says when it runs.
+    leftover = subprocess.Popen(
+        [sys.executable, '-c', 'import time; print("up", flush=True); time.sleep(60)'],
+        env={**os.environ, 'ROS_DOMAIN_ID': '9999'}, stdout=subprocess.PIPE, text=True)
     try:
+        assert leftover.stdout.readline() == 'up\n'
         assert 9999 in swivel_car_testing.domains_in_use()
     finally:
         leftover.kill()
         leftover.wait()
+        leftover.stdout.close()
     assert 9999 not in swivel_car_testing.domains_in_use()
 
 
