@@ -58,12 +58,6 @@ NODES = {'sim': ('swivel_car_sim', 'sim_node'),
          'planner': ('swivel_car_planner', 'planner_node')}
 # What each node other than the sim logs once it is up.
 UP_LOGS = {'controller': 'controller up', 'odometry': 'odometry up', 'planner': 'planner ready'}
-# An endpoint of each such node that this node's graph shows once discovery has reached it:
-# (kind, name); for the odometry, outside the chain, the one it hears the sim on. A restarted
-# node is discovered some 1-3 s after it is up.
-DISCOVERED_BY = {'controller': ('publishers', 'controller/controller_state'),
-                 'odometry': ('subscribers', 'joint_states'),
-                 'planner': ('services', 'climb_step')}
 # After this many wall seconds without a command the sim takes the controller for gone and
 # runs on at real time with its watchdog (a killed controller); the controller waits half
 # of it for the planner and this test's driver. Long enough that a loaded machine never holds
@@ -89,9 +83,6 @@ REJOIN_AFTER = 10.0  # [s]
 # Wall time without a truth, odom or controller state after which a killed sim's world has
 # been heard to its end: a new sim is resumed only then (Stack._resuming).
 QUIET = 1.0  # [s]
-# Wall time a restarted node that is up may take to show in this node's graph while the sim
-# waits paused for it (Stack.restart).
-DISCOVERY_WAIT = 5.0  # [s]
 
 
 def time_msg(t: float) -> Time:
@@ -104,7 +95,7 @@ class Stack:
 
     def __init__(self, domain_id: int, context) -> None:
         self.domain_id = domain_id
-        # The sim paused until the stack is up and discovered (start_up, in shared_stack).
+        # The sim paused until this node has discovered it (resume_sim, in shared_stack).
         self.processes = {name: self.start(name, paused=True) for name in NODES}
         self.user = Node('user', context=context,
                          parameter_overrides=[Parameter('use_sim_time', value=True)])
@@ -236,23 +227,17 @@ class Stack:
         while another node boots; a new sim starts paused and runs once this node hears it.
         """
         resumed = self._sim_resumed() if heard is not None and name == 'controller' else 0
-        # While a node boots and is discovered (2-5 s of wall time) the chain would run flat
-        # out for nobody (20-60 s of sim time): the sim waits, paused, until the node says it
-        # is up and this node's graph shows it (or DISCOVERY_WAIT has passed: the node may
-        # need the chain to run, or Fast DDS may have left it unmatched, see REJOIN_AFTER).
+        # While a node boots (1-2.5 s of wall time) the chain would run flat out for nobody:
+        # the sim waits, paused, until the node says it is up.
         pause = name in UP_LOGS and 'sim' in self.processes
         if pause:
             self.pause_sim(True)
-            discovered = self._discovered(name)
         if name == 'sim':  # the old one, if still matched: the new one cannot be yet
             self._sims_matched_floor = self._truth_subscription.get_publisher_count()
             self.resumed_counts = None
         self.processes[name] = self.start(name, paused=name == 'sim')
         if pause:
             self.processes[name].wait_for_output(UP_LOGS[name], 60.0)
-            deadline = time.monotonic() + DISCOVERY_WAIT
-            self.spin_until(lambda: discovered() or time.monotonic() > deadline,
-                            DISCOVERY_WAIT + 10.0, f'the new {name} in the graph')
             self.pause_sim(False)
         if name == 'odometry':
             self.odom_time = None  # until the new one publishes
@@ -269,10 +254,7 @@ class Stack:
         if heard is None:
             return
         try:
-            if name == 'odometry':  # outside the chain (docs/architecture.md)
-                self._trickle_until(heard, REJOIN_AFTER, what)
-            else:
-                self.spin_until(heard, REJOIN_AFTER, what)
+            self.spin_until(heard, REJOIN_AFTER, what)
         except TimeoutError:
             why = f'{what} not heard in {REJOIN_AFTER} s'
         else:
@@ -312,59 +294,6 @@ class Stack:
                 asked = now
             return False
         return resumed_and_heard
-
-    def start_up(self) -> None:
-        """
-        Resume the sim, started paused, once every node is up and in this node's graph.
-
-        At most DISCOVERY_WAIT after the last is up. Resumed at once, the chain ran flat out
-        (up to 45 s of sim time) until the odometry and the planner had matched it.
-        """
-        for name, log in UP_LOGS.items():
-            self.processes[name].wait_for_output(log, 60.0)
-        # A fresh domain: none of their endpoints before.
-        discovered = [self._discovered(name, fewest=0) for name in DISCOVERED_BY]
-        deadline = time.monotonic() + DISCOVERY_WAIT
-        self.spin_until(lambda: all(d() for d in discovered) or time.monotonic() > deadline,
-                        DISCOVERY_WAIT + 10.0, 'the stack in the graph')
-        resume_sim(self.executor, self.set_paused)
-
-    def _discovered(self, name: str, fewest: int | None = None) -> Callable[[], bool]:
-        """
-        Return whether this node's graph has shown node ``name``'s endpoint since now.
-
-        That is, more of them than the fewest seen from now on (``fewest``: so far; None: now):
-        a killed node's stay in the graph until its lease runs out, at any moment.
-        """
-        kind, endpoint = DISCOVERED_BY[name]
-        count = getattr(self.user, f'count_{kind}')
-        fewest = count(endpoint) if fewest is None else fewest
-
-        def discovered() -> bool:
-            nonlocal fewest
-            now = count(endpoint)
-            fewest = min(fewest, now)
-            return now > fewest
-        return discovered
-
-    def _trickle_until(self, heard: Callable[[], bool], timeout: float, what: str) -> None:
-        """
-        Spin until ``heard()``, the sim running 0.05 s of sim time in every 0.25 s of wall time.
-
-        For a node outside the chain, heard only once it has matched the running stack (1-3 s
-        after it is up): meanwhile the chain would run flat out for nobody (20-30 s of sim
-        time). Raises TimeoutError after ``timeout`` [s] of wall time, as spin_until.
-        """
-        deadline = time.monotonic() + timeout
-        while not heard():
-            if time.monotonic() > deadline:
-                raise TimeoutError(f'{what}: not within {timeout} s')
-            self.wait_sim_time(0.05, what)
-            self.pause_sim(True)
-            try:
-                self.wait_wall(0.2, what)
-            finally:
-                self.pause_sim(False)
 
     def pause_sim(self, paused: bool) -> None:
         response = self.call(self.set_paused, SetBool.Request(data=paused), 'sim/set_paused')
@@ -569,46 +498,35 @@ class Stack:
         deaf_since: float | None = None  # [s] wall: the first NOT_READY of those in a row
         rejoined = False
         while True:
-            # The planner asked with this moment's inputs fresh, the sim paused meanwhile: a
-            # request it does not answer (below) or a planner still deaf to the stack (its
-            # subscriptions match 1-3 s after it is up) would otherwise let the chain run flat
-            # out for nobody while this node waits (15-25 s of sim time).
-            self.wait_sim_time(0.05, 'the planner to hear the stack')
-            self.pause_sim(True)
-            try:
-                future = self.climb.call_async(ClimbStep.Request(
-                    step_height=10.0, step_distance=1.0, step_yaw=0.0, plan_only=False))
-                # A request sent before a restarted planner's server was matched reaches only
-                # the dead one (the graph keeps it until its lease ends, ~20 s): ask again.
-                retry = min(deadline, time.monotonic() + 3.0)
-                self.spin_until(lambda: future.done() or time.monotonic() > retry, 30.0,
-                                'a refusal')
-                if not future.done():
-                    self.climb.remove_pending_request(future)
-                    assert time.monotonic() < deadline, 'the planner never answered:\n' + \
-                        self.processes['planner'].output()[-3000:]
+            future = self.climb.call_async(ClimbStep.Request(
+                step_height=10.0, step_distance=1.0, step_yaw=0.0, plan_only=False))
+            # A request sent before a restarted planner's server was matched reaches only
+            # the dead one (the graph keeps it until its lease ends, ~20 s): ask again.
+            retry = min(deadline, time.monotonic() + 3.0)
+            self.spin_until(lambda: future.done() or time.monotonic() > retry, 30.0,
+                            'a refusal')
+            if not future.done():
+                self.climb.remove_pending_request(future)
+                assert time.monotonic() < deadline, 'the planner never answered:\n' + \
+                    self.processes['planner'].output()[-3000:]
+                continue
+            # BUSY: the planner still plans a request of this loop whose answer was given up.
+            code = future.result().error_code
+            if code not in (ClimbStep.Response.ERROR_NOT_READY, ClimbStep.Response.ERROR_BUSY):
+                assert code == ClimbStep.Response.ERROR_UNREACHABLE_HEIGHT, \
+                    future.result().message
+                return
+            if code == ClimbStep.Response.ERROR_NOT_READY:
+                deaf_since = deaf_since or time.monotonic()
+                if time.monotonic() - deaf_since > REJOIN_AFTER:
+                    assert not rejoined, future.result().message
+                    self.rejoin('planner', future.result().message)
+                    rejoined, deaf_since = True, None
+                    deadline = time.monotonic() + 60.0
                     continue
-                # BUSY: the planner still plans a request of this loop whose answer was given
-                # up.
-                code = future.result().error_code
-                if code not in (ClimbStep.Response.ERROR_NOT_READY,
-                                ClimbStep.Response.ERROR_BUSY):
-                    assert code == ClimbStep.Response.ERROR_UNREACHABLE_HEIGHT, \
-                        future.result().message
-                    return
-                if code == ClimbStep.Response.ERROR_NOT_READY:
-                    deaf_since = deaf_since or time.monotonic()
-                    if time.monotonic() - deaf_since > REJOIN_AFTER:
-                        assert not rejoined, future.result().message
-                        self.rejoin('planner', future.result().message)
-                        rejoined, deaf_since = True, None
-                        deadline = time.monotonic() + 60.0
-                        continue
-                else:
-                    deaf_since = None
-                self.wait_wall(0.2, 'the planner to match the stack')
-            finally:
-                self.pause_sim(False)
+            else:
+                deaf_since = None
+            self.wait_sim_time(0.2, 'the planner to hear the stack')
 
     def start_climb(self, request: ClimbStep.Request) -> Future:
         self.climbs.append(self.climb.call_async(request))
@@ -661,7 +579,7 @@ def shared_stack() -> Iterator[Stack]:
     rclpy.init(context=context, domain_id=domain_id)
     running = Stack(domain_id, context)
     try:
-        running.start_up()
+        resume_sim(running.executor, running.set_paused)
         yield running
     finally:
         running.close()
