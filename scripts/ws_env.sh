@@ -11,10 +11,8 @@ export PATH="$_repo/.venv/bin:$PATH"
 # Compiling the whole venv ahead took 35 s of CPU, most of it for modules no program imports.
 unset PYTHONDONTWRITEBYTECODE
 export PYTHONPYCACHEPREFIX="$_repo/.venv/pycache"
-# One BLAS thread per process, as stack.launch.py sets for the robot: every process of the
-# stack multiplies small matrices, and OpenBLAS's extra threads spin for a while after each
-# call. They took the step detector 0.7 of a core beside its own 0.15 at 10 frames a second,
-# and the test suite some 20 s of its CPU. A value set outside stays.
+# One BLAS thread per process, as stack.launch.py sets for the robot (README, "With a real
+# driver"): OpenBLAS's extra threads spin after each call. A value set outside stays.
 export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}"
 export ROS_AUTOMATIC_DISCOVERY_RANGE="${ROS_AUTOMATIC_DISCOVERY_RANGE:-LOCALHOST}"
 if [ -f "$_repo/ros2_ws/install/setup.bash" ]; then

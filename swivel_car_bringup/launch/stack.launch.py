@@ -38,9 +38,8 @@ def generate_launch_description() -> LaunchDescription:
     use_sim_time = {'use_sim_time': ParameterValue(on_sim_time, value_type=bool)}
     sim_time_argument = {'use_sim_time': on_sim_time}
     return LaunchDescription([
-        # One BLAS thread per node unless set otherwise: each node multiplies small matrices,
-        # and OpenBLAS's extra threads spin for a while after each call (the step detector's
-        # took 0.7 of a core at 10 frames a second, beside its own 0.15).
+        # One BLAS thread per node unless set otherwise: OpenBLAS's extra threads spin after
+        # each call (the README, "With a real driver", has what they cost).
         SetEnvironmentVariable('OPENBLAS_NUM_THREADS', EnvironmentVariable(
             'OPENBLAS_NUM_THREADS', default_value='1')),
         DeclareLaunchArgument('clock_source', default_value='sim',
