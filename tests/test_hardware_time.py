@@ -62,10 +62,11 @@ STANDING_TIME = 0.5  # [s] of ground-truth stamps below STANDING_SPEED: the car 
 
 def standing(truth: list[Odometry]) -> bool:
     """Tell whether every ground truth of the last STANDING_TIME is below STANDING_SPEED."""
-    if not truth or (stamp_to_seconds(truth[-1].header.stamp)
-                     - stamp_to_seconds(truth[0].header.stamp)) < STANDING_TIME:
+    if not truth:
         return False
     since = stamp_to_seconds(truth[-1].header.stamp) - STANDING_TIME
+    if stamp_to_seconds(truth[0].header.stamp) > since:
+        return False
     recent = [m for m in truth[-200:]  # 200: 2 s at 100 Hz
               if stamp_to_seconds(m.header.stamp) >= since]
     return all(GroundTruth.from_msg(m).speed < STANDING_SPEED for m in recent)
