@@ -22,6 +22,7 @@ not depend on how the one before it ended.
 from __future__ import annotations
 
 from collections import deque
+import contextlib
 import math
 import os
 import time
@@ -45,7 +46,7 @@ from std_msgs.msg import Header
 from std_srvs.srv import Empty, SetBool
 from swivel_car_model.params import SwivelCarParams
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
-from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle
+from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle, StepSimulation
 from swivel_car_ros.ros_params import moment_seconds, stamp_to_seconds
 from swivel_car_sim.sim_node import LOCKSTEP_RESUMED_LOG, LOCKSTEP_TIMED_OUT_LOG
 from swivel_car_testing import (
@@ -83,6 +84,10 @@ REJOIN_AFTER = 10.0  # [s]
 # Wall time without a truth, odom or controller state after which a killed sim's world has
 # been heard to its end: a new sim is resumed only then (Stack._resuming).
 QUIET = 1.0  # [s]
+# Stack.paced: the sim runs this much sim time at a time, each slice no sooner than this much
+# wall time after the one before, so that it never runs ahead of the wall clock by more.
+PACE_SLICE = 0.02  # [s]
+TIME_STEP = 0.002  # [s] sim_node.yaml
 
 
 def time_msg(t: float) -> Time:
@@ -134,6 +139,9 @@ class Stack:
         self.joint_states = self.user.create_publisher(JointState, 'joint_states', 10)
         self.swivel_command = self.user.create_publisher(SwivelCommand, 'swivel_command', 10)
         self.set_paused = self.user.create_client(SetBool, 'sim/set_paused')
+        self.run_sim = self.user.create_client(StepSimulation, 'sim/run')
+        self._pace: Future | None = None  # the last sim/run of Stack.paced
+        self._pace_started = math.nan  # [s] wall: when it was sent; nan: not paced
         self.set_controller_parameters = self.user.create_client(
             SetParameters, 'controller/set_parameters')
         self.spawn = self.user.create_client(SpawnObstacle, 'sim/spawn_obstacle')
@@ -335,11 +343,50 @@ class Stack:
         self.kill(name)
         self.restart(name)
 
+    @contextlib.contextmanager
+    def paced(self) -> Iterator[None]:
+        """
+        Within: the sim runs no faster than the wall clock, while this node spins.
+
+        For a node on the wall clock (a controller flipped to use_sim_time false) judged in
+        sim time. Unpaced, the chain runs up to 2.4 s of sim time in a second: a 0.5 s deadman
+        on the wall clock lasted 1.2 s of sim time. Paused, the sim runs PACE_SLICE at a time
+        (``~/run``), each slice once the one before has been heard and PACE_SLICE of wall time
+        after it was sent: slower than the wall clock on a loaded machine, never faster.
+        """
+        self.pause_sim(True)
+        self._pace, self._pace_started = None, -math.inf
+        try:
+            yield
+        finally:
+            self._pace = None
+            self._pace_started = math.nan  # not paced
+            self.pause_sim(False)
+
+    def _run_slice_when_due(self) -> None:
+        """Stack.paced: send the next slice's ``~/run`` once the last one is over."""
+        if self._pace is not None:
+            if not self._pace.done():
+                return
+            response = self._pace.result()
+            assert response.success, response.message
+            if self.sim_time() < stamp_to_seconds(response.sim_time):
+                return  # the slice still running, or its last state not yet heard
+        if time.monotonic() < self._pace_started + PACE_SLICE:
+            return
+        self._pace_started = time.monotonic()
+        self._pace = self.run_sim.call_async(
+            StepSimulation.Request(steps=round(PACE_SLICE / TIME_STEP)))
+
     def spin_until(self, condition, timeout: float = 60.0, what: str = 'condition') -> None:
         def checked() -> bool:
             for name, process in self.processes.items():
                 assert process.running(), f'{name} died:\n{process.output()[-3000:]}'
-            return condition()
+            if condition():
+                return True
+            if not math.isnan(self._pace_started):
+                self._run_slice_when_due()
+            return False
         try:
             spin_until(self.executor, checked, timeout, what)
         except TimeoutError as error:
@@ -805,18 +852,20 @@ def test_a_use_sim_time_flip_mid_drive_does_not_stretch_the_cmd_vel_deadman(stac
         # counts from the controller's first step after its receipt (a stamp ahead of the step
         # counts as given then), which the states report: when that was depends on who got
         # the CPU first (the controller waits 1.5 s of wall time for an answer, then goes on).
-        wall_ns = time.time_ns()  # [ns]
-        wall = Time(sec=wall_ns // 10**9, nanosec=wall_ns % 10**9)
-        stack.release(wall)
+        # A deadman on the wall clock is judged in sim time with the sim paced.
+        with stack.paced():
+            wall_ns = time.time_ns()  # [ns]
+            wall = Time(sec=wall_ns // 10**9, nanosec=wall_ns % 10**9)
+            stack.release(wall)
 
-        def heard() -> float:
-            return next(stamp_to_seconds(s.header.stamp) for s in stack.controller_states
-                        if s.cmd_vel_stamp == wall)
+            def heard() -> float:
+                return next(stamp_to_seconds(s.header.stamp) for s in stack.controller_states
+                            if s.cmd_vel_stamp == wall)
 
-        stack.wait_stopped(DEADMAN + BRAKING + 0.1, 'the car to stop after the flip',
-                           since=heard)
-        stack.wait_sim_time(1.0, 'the car to stand')
-        assert stack.speed() < 0.02
+            stack.wait_stopped(DEADMAN + BRAKING + 0.1, 'the car to stop after the flip',
+                               since=heard)
+            stack.wait_sim_time(1.0, 'the car to stand')
+            assert stack.speed() < 0.02
         use_sim_time(True)
     except BaseException:
         stack.kill('controller')  # the next test gets a new one, on sim time

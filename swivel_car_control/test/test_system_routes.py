@@ -28,6 +28,7 @@ import pytest
 import rclpy
 from rclpy.context import Context
 from rclpy.experimental import EventsExecutor
+from sim_session import RESEND_AFTER
 from std_srvs.srv import Empty, SetBool
 from swivel_car_control.benchmark import routes, Segment
 from swivel_car_control.test.test_system import _seconds, _yaw
@@ -35,8 +36,10 @@ from swivel_car_model.description import CarDescription
 from swivel_car_msgs.msg import SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ResetSimulation
 from swivel_car_ros.lockstep import ChainEntry, Entry, stamp_ns
+from swivel_car_stack import ResentRequest
 from swivel_car_testing import (
-    lockstep_parameters, next_domain_id, resume_sim, spin_until, start_node)
+    lockstep_parameters, next_domain_id, NodeProcess, process_report, resume_sim, spin_until,
+    start_node)
 
 SETTLE = 1.0  # [s] sim time standing still at the end of a route, as the benchmark
 # Our odometry's end-pose error, % of the distance travelled; the in-process benchmark
@@ -51,7 +54,8 @@ MAX_STANDSTILL_ERROR = 0.06
 class RouteDriver:
     """Drives a route's segments, one command per controller state."""
 
-    def __init__(self, context: Context) -> None:
+    def __init__(self, context: Context, processes: list[NodeProcess]) -> None:
+        self.processes = processes
         self.node = rclpy.create_node('route_driver', context=context)
         self.executor = EventsExecutor(context=context)
         self.executor.add_node(self.node)
@@ -128,22 +132,29 @@ class RouteDriver:
             command.twist.linear.x, command.twist.angular.z = segment.a, segment.b
         self.cmd_vel.publish(command)
 
+    def spin_until(self, condition, timeout: float, what: str) -> None:
+        try:
+            spin_until(self.executor, condition, timeout, what)
+        except TimeoutError as error:
+            # What each node said is the only trace of why a wait ran out.
+            raise TimeoutError(f'{error}\n{process_report(self.processes)}') from None
+
     def call(self, client, request) -> None:
-        spin_until(self.executor, client.service_is_ready, 60.0, client.srv_name)
-        future = client.call_async(request)
-        spin_until(self.executor, future.done, 30.0, client.srv_name)
-        assert getattr(future.result(), 'success', True), future.result()
+        """Call a service whose request may come twice (a reset), resent until answered."""
+        self.spin_until(client.service_is_ready, 60.0, client.srv_name)
+        call = ResentRequest(client, request, RESEND_AFTER)
+        self.spin_until(call.done, 30.0, client.srv_name)
+        assert getattr(call.result(), 'success', True), call.result()
 
     def run(self, segments: list[Segment]) -> float:
         """Drive ``segments`` from the next controller state on; returns their end time [s]."""
         self.start = (segments, ChainEntry())
-        spin_until(self.executor, lambda: self.start is None and not self.plan, 600.0,
-                   'the segments')
+        self.spin_until(lambda: self.start is None and not self.plan, 600.0, 'the segments')
         return self.end
 
     def wait(self, seconds: float, what: str) -> None:
         end = self.time + seconds
-        spin_until(self.executor, lambda: self.time >= end, 30.0, what)
+        self.spin_until(lambda: self.time >= end, 30.0, what)
 
     def drive(self, segments: list[Segment]) -> tuple[Odometry, Odometry, float]:
         """
@@ -164,7 +175,7 @@ class RouteDriver:
         def common_stamp():
             return min((t for t in self.odom if t >= end and t in self.truth), default=None)
 
-        spin_until(self.executor, lambda: common_stamp() is not None, 30.0, 'the end pose')
+        self.spin_until(lambda: common_stamp() is not None, 30.0, 'the end pose')
         stamp = common_stamp()
         truth = [self.truth[t] for t in sorted(self.truth) if start <= t <= stamp]
         distance = sum(math.hypot(b.pose.pose.position.x - a.pose.pose.position.x,
@@ -191,12 +202,12 @@ def driver():
             ('swivel_car_sim', 'sim_node', {'start_paused': True}),
             ('swivel_car_control', 'controller_node', {}),
             ('swivel_car_control', 'odometry_node', {}))]
-    route_driver = RouteDriver(context)
+    route_driver = RouteDriver(context, processes)
     try:
         resume_sim(route_driver.executor,
                    route_driver.node.create_client(SetBool, 'sim/set_paused'))
-        spin_until(route_driver.executor, lambda: route_driver.time > 0.0 and route_driver.odom,
-                   60.0, 'the stack')
+        route_driver.spin_until(lambda: route_driver.time > 0.0 and route_driver.odom, 60.0,
+                                'the stack')
         yield route_driver
     finally:
         route_driver.close()
