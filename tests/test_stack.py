@@ -59,6 +59,12 @@ NODES = {'sim': ('swivel_car_sim', 'sim_node'),
          'planner': ('swivel_car_planner', 'planner_node')}
 # What each node other than the sim logs once it is up.
 UP_LOGS = {'controller': 'controller up', 'odometry': 'odometry up', 'planner': 'planner ready'}
+# An endpoint of each such node that this node's graph shows once discovery has reached it:
+# (kind, name); for the odometry, outside the chain, the one it hears the sim on. A restarted
+# node is discovered some 1-3 s after it is up.
+DISCOVERED_BY = {'controller': ('publishers', 'controller/controller_state'),
+                 'odometry': ('subscribers', 'joint_states'),
+                 'planner': ('services', 'climb_step')}
 # After this many wall seconds without a command the sim takes the controller for gone and
 # runs on at real time with its watchdog (a killed controller); the controller waits half
 # of it for the planner and this test's driver. Long enough that a loaded machine never holds
@@ -84,10 +90,13 @@ REJOIN_AFTER = 10.0  # [s]
 # Wall time without a truth, odom or controller state after which a killed sim's world has
 # been heard to its end: a new sim is resumed only then (Stack._resuming).
 QUIET = 1.0  # [s]
-# Stack.paced: the sim runs this much sim time at a time, each slice no sooner than this much
-# wall time after the one before, so that it never runs ahead of the wall clock by more.
+# Stack.paced: the sim runs this much sim time at a time, so that it never runs ahead of the
+# pace by more.
 PACE_SLICE = 0.02  # [s]
 TIME_STEP = 0.002  # [s] sim_node.yaml
+# Wall time a restarted node that is up may take to show in this node's graph while the sim
+# waits paused for it (Stack.restart).
+DISCOVERY_WAIT = 5.0  # [s]
 
 
 def time_msg(t: float) -> Time:
@@ -100,7 +109,7 @@ class Stack:
 
     def __init__(self, domain_id: int, context) -> None:
         self.domain_id = domain_id
-        # The sim paused until this node has discovered it (resume_sim, in shared_stack).
+        # The sim paused until the stack is up and discovered (start_up, in shared_stack).
         self.processes = {name: self.start(name, paused=True) for name in NODES}
         self.user = Node('user', context=context,
                          parameter_overrides=[Parameter('use_sim_time', value=True)])
@@ -140,8 +149,11 @@ class Stack:
         self.swivel_command = self.user.create_publisher(SwivelCommand, 'swivel_command', 10)
         self.set_paused = self.user.create_client(SetBool, 'sim/set_paused')
         self.run_sim = self.user.create_client(StepSimulation, 'sim/run')
-        self._pace: Future | None = None  # the last sim/run of Stack.paced
-        self._pace_started = math.nan  # [s] wall: when it was sent; nan: not paced
+        # Stack.paced: wall time between its slices (None: not paced), the last slice's
+        # sim/run call and when it was sent.
+        self._pace_interval: float | None = None  # [s]
+        self._pace: Future | None = None
+        self._pace_started = -math.inf  # [s] wall
         self.set_controller_parameters = self.user.create_client(
             SetParameters, 'controller/set_parameters')
         self.spawn = self.user.create_client(SpawnObstacle, 'sim/spawn_obstacle')
@@ -235,17 +247,23 @@ class Stack:
         while another node boots; a new sim starts paused and runs once this node hears it.
         """
         resumed = self._sim_resumed() if heard is not None and name == 'controller' else 0
-        # While a node boots (1-2.5 s of wall time) the chain would run flat out for nobody:
-        # the sim waits, paused, until the node says it is up.
+        # While a node boots and is discovered (2-5 s of wall time) the chain would run flat
+        # out for nobody (20-60 s of sim time): the sim waits, paused, until the node says it
+        # is up and this node's graph shows it (or DISCOVERY_WAIT has passed: the node may
+        # need the chain to run, or Fast DDS may have left it unmatched, see REJOIN_AFTER).
         pause = name in UP_LOGS and 'sim' in self.processes
         if pause:
             self.pause_sim(True)
+            discovered = self._discovered(name)
         if name == 'sim':  # the old one, if still matched: the new one cannot be yet
             self._sims_matched_floor = self._truth_subscription.get_publisher_count()
             self.resumed_counts = None
         self.processes[name] = self.start(name, paused=name == 'sim')
         if pause:
             self.processes[name].wait_for_output(UP_LOGS[name], 60.0)
+            deadline = time.monotonic() + DISCOVERY_WAIT
+            self.spin_until(lambda: discovered() or time.monotonic() > deadline,
+                            DISCOVERY_WAIT + 10.0, f'the new {name} in the graph')
             self.pause_sim(False)
         if name == 'odometry':
             self.odom_time = None  # until the new one publishes
@@ -262,7 +280,14 @@ class Stack:
         if heard is None:
             return
         try:
-            self.spin_until(heard, REJOIN_AFTER, what)
+            if name == 'odometry':
+                # Outside the chain (docs/architecture.md), heard only once it has matched the
+                # running stack (1-3 s after it is up): meanwhile the chain would run flat out
+                # for nobody (20-30 s of sim time).
+                with self.paced(real_time_factor=0.2):
+                    self.spin_until(heard, REJOIN_AFTER, what)
+            else:
+                self.spin_until(heard, REJOIN_AFTER, what)
         except TimeoutError:
             why = f'{what} not heard in {REJOIN_AFTER} s'
         else:
@@ -302,6 +327,40 @@ class Stack:
                 asked = now
             return False
         return resumed_and_heard
+
+    def start_up(self) -> None:
+        """
+        Resume the sim, started paused, once every node is up and in this node's graph.
+
+        At most DISCOVERY_WAIT after the last is up. Resumed at once, the chain ran flat out
+        (up to 45 s of sim time) until the odometry and the planner had matched it.
+        """
+        for name, log in UP_LOGS.items():
+            self.processes[name].wait_for_output(log, 60.0)
+        # A fresh domain: none of their endpoints before.
+        discovered = [self._discovered(name, fewest=0) for name in DISCOVERED_BY]
+        deadline = time.monotonic() + DISCOVERY_WAIT
+        self.spin_until(lambda: all(d() for d in discovered) or time.monotonic() > deadline,
+                        DISCOVERY_WAIT + 10.0, 'the stack in the graph')
+        resume_sim(self.executor, self.set_paused)
+
+    def _discovered(self, name: str, fewest: int | None = None) -> Callable[[], bool]:
+        """
+        Return whether this node's graph has shown node ``name``'s endpoint since now.
+
+        That is, more of them than the fewest seen from now on (``fewest``: so far; None: now):
+        a killed node's stay in the graph until its lease runs out, at any moment.
+        """
+        kind, endpoint = DISCOVERED_BY[name]
+        count = getattr(self.user, f'count_{kind}')
+        fewest = count(endpoint) if fewest is None else fewest
+
+        def discovered() -> bool:
+            nonlocal fewest
+            now = count(endpoint)
+            fewest = min(fewest, now)
+            return now > fewest
+        return discovered
 
     def pause_sim(self, paused: bool) -> None:
         response = self.call(self.set_paused, SetBool.Request(data=paused), 'sim/set_paused')
@@ -344,23 +403,24 @@ class Stack:
         self.restart(name)
 
     @contextlib.contextmanager
-    def paced(self) -> Iterator[None]:
+    def paced(self, real_time_factor: float = 1.0) -> Iterator[None]:
         """
-        Within: the sim runs no faster than the wall clock, while this node spins.
+        Within: the sim runs no faster than ``real_time_factor`` [1], while this node spins.
 
         For a node on the wall clock (a controller flipped to use_sim_time false) judged in
-        sim time. Unpaced, the chain runs up to 2.4 s of sim time in a second: a 0.5 s deadman
-        on the wall clock lasted 1.2 s of sim time. Paused, the sim runs PACE_SLICE at a time
-        (``~/run``), each slice once the one before has been heard and PACE_SLICE of wall time
-        after it was sent: slower than the wall clock on a loaded machine, never faster.
+        sim time: unpaced, the chain runs up to 2.4 s of sim time in a second, and a 0.5 s
+        deadman on the wall clock lasted 1.2 s of sim time. Paused, the sim runs PACE_SLICE at
+        a time (``~/run``), each slice once the one before has been heard and PACE_SLICE /
+        ``real_time_factor`` of wall time after it was sent: slower on a loaded machine,
+        never faster.
         """
         self.pause_sim(True)
-        self._pace, self._pace_started = None, -math.inf
+        self._pace, self._pace_interval = None, PACE_SLICE / real_time_factor
+        self._pace_started = -math.inf
         try:
             yield
         finally:
-            self._pace = None
-            self._pace_started = math.nan  # not paced
+            self._pace, self._pace_interval = None, None
             self.pause_sim(False)
 
     def _run_slice_when_due(self) -> None:
@@ -372,7 +432,7 @@ class Stack:
             assert response.success, response.message
             if self.sim_time() < stamp_to_seconds(response.sim_time):
                 return  # the slice still running, or its last state not yet heard
-        if time.monotonic() < self._pace_started + PACE_SLICE:
+        if time.monotonic() < self._pace_started + self._pace_interval:
             return
         self._pace_started = time.monotonic()
         self._pace = self.run_sim.call_async(
@@ -384,7 +444,7 @@ class Stack:
                 assert process.running(), f'{name} died:\n{process.output()[-3000:]}'
             if condition():
                 return True
-            if not math.isnan(self._pace_started):
+            if self._pace_interval is not None:
                 self._run_slice_when_due()
             return False
         try:
@@ -545,35 +605,46 @@ class Stack:
         deaf_since: float | None = None  # [s] wall: the first NOT_READY of those in a row
         rejoined = False
         while True:
-            future = self.climb.call_async(ClimbStep.Request(
-                step_height=10.0, step_distance=1.0, step_yaw=0.0, plan_only=False))
-            # A request sent before a restarted planner's server was matched reaches only
-            # the dead one (the graph keeps it until its lease ends, ~20 s): ask again.
-            retry = min(deadline, time.monotonic() + 3.0)
-            self.spin_until(lambda: future.done() or time.monotonic() > retry, 30.0,
-                            'a refusal')
-            if not future.done():
-                self.climb.remove_pending_request(future)
-                assert time.monotonic() < deadline, 'the planner never answered:\n' + \
-                    self.processes['planner'].output()[-3000:]
-                continue
-            # BUSY: the planner still plans a request of this loop whose answer was given up.
-            code = future.result().error_code
-            if code not in (ClimbStep.Response.ERROR_NOT_READY, ClimbStep.Response.ERROR_BUSY):
-                assert code == ClimbStep.Response.ERROR_UNREACHABLE_HEIGHT, \
-                    future.result().message
-                return
-            if code == ClimbStep.Response.ERROR_NOT_READY:
-                deaf_since = deaf_since or time.monotonic()
-                if time.monotonic() - deaf_since > REJOIN_AFTER:
-                    assert not rejoined, future.result().message
-                    self.rejoin('planner', future.result().message)
-                    rejoined, deaf_since = True, None
-                    deadline = time.monotonic() + 60.0
+            # The planner asked with this moment's inputs fresh, the sim paused meanwhile: a
+            # request it does not answer (below) or a planner still deaf to the stack (its
+            # subscriptions match 1-3 s after it is up) would otherwise let the chain run flat
+            # out for nobody while this node waits (15-25 s of sim time).
+            self.wait_sim_time(0.05, 'the planner to hear the stack')
+            self.pause_sim(True)
+            try:
+                future = self.climb.call_async(ClimbStep.Request(
+                    step_height=10.0, step_distance=1.0, step_yaw=0.0, plan_only=False))
+                # A request sent before a restarted planner's server was matched reaches only
+                # the dead one (the graph keeps it until its lease ends, ~20 s): ask again.
+                retry = min(deadline, time.monotonic() + 3.0)
+                self.spin_until(lambda: future.done() or time.monotonic() > retry, 30.0,
+                                'a refusal')
+                if not future.done():
+                    self.climb.remove_pending_request(future)
+                    assert time.monotonic() < deadline, 'the planner never answered:\n' + \
+                        self.processes['planner'].output()[-3000:]
                     continue
-            else:
-                deaf_since = None
-            self.wait_sim_time(0.2, 'the planner to hear the stack')
+                # BUSY: the planner still plans a request of this loop whose answer was given
+                # up.
+                code = future.result().error_code
+                if code not in (ClimbStep.Response.ERROR_NOT_READY,
+                                ClimbStep.Response.ERROR_BUSY):
+                    assert code == ClimbStep.Response.ERROR_UNREACHABLE_HEIGHT, \
+                        future.result().message
+                    return
+                if code == ClimbStep.Response.ERROR_NOT_READY:
+                    deaf_since = deaf_since or time.monotonic()
+                    if time.monotonic() - deaf_since > REJOIN_AFTER:
+                        assert not rejoined, future.result().message
+                        self.rejoin('planner', future.result().message)
+                        rejoined, deaf_since = True, None
+                        deadline = time.monotonic() + 60.0
+                        continue
+                else:
+                    deaf_since = None
+                self.wait_wall(0.2, 'the planner to match the stack')
+            finally:
+                self.pause_sim(False)
 
     def start_climb(self, request: ClimbStep.Request) -> Future:
         self.climbs.append(self.climb.call_async(request))
@@ -626,7 +697,7 @@ def shared_stack() -> Iterator[Stack]:
     rclpy.init(context=context, domain_id=domain_id)
     running = Stack(domain_id, context)
     try:
-        resume_sim(running.executor, running.set_paused)
+        running.start_up()
         yield running
     finally:
         running.close()
