@@ -5,10 +5,19 @@ A participant given such a port waits for it forever inside rclpy's Node(); next
 removes them before a process's first domain (swivel_car_testing.remove_unborn_shm_ports).
 """
 
+import os
 from pathlib import Path
+import time
 
 import pytest
-from swivel_car_testing import next_domain_id, NodeProcess, remove_unborn_shm_ports
+from swivel_car_testing import next_domain_id, NodeProcess, remove_unborn_shm_ports, UNBORN_AGE
+
+
+def left_long_ago(*paths: Path) -> None:
+    """Date ``paths`` back as a killed run's leftovers are."""
+    then = time.time() - 2.0 * UNBORN_AGE  # [s] since the epoch
+    for path in paths:
+        os.utime(path, (then, then))
 
 
 def test_only_unborn_ports_that_no_process_holds_are_removed(tmp_path):
@@ -22,6 +31,9 @@ def test_only_unborn_ports_that_no_process_holds_are_removed(tmp_path):
     kept[1].write_bytes(bytes(100))  # unborn, but being created: its creator holds it
     kept[2].write_bytes(b'')  # a lock file
     kept[3].write_bytes(bytes(100))  # a data segment, not a port
+    left_long_ago(unborn, mutex, *kept)
+    kept.append(tmp_path / 'fastrtps_port7419')
+    kept[4].write_bytes(bytes(100))  # unborn, but new: its creator may not be seen yet
     with kept[1].open('rb'):
         assert remove_unborn_shm_ports(tmp_path) == [unborn.name]
     assert not unborn.exists() and not mutex.exists()
@@ -46,6 +58,7 @@ def test_a_node_whose_port_was_left_unborn_starts_once_it_is_removed():
     for port in ports:
         with port.open('xb') as file:  # never over a port that appeared meanwhile
             file.write(bytes(52400))
+    left_long_ago(*ports)
     remove_unborn_shm_ports()
     # Gone, whoever removed them: another test worker claiming its first domain removes
     # unborn ports too.

@@ -14,6 +14,7 @@ import itertools
 import os
 from pathlib import Path
 import tempfile
+import time
 from typing import Any, IO
 
 from std_srvs.srv import SetBool
@@ -23,7 +24,7 @@ from swivel_car_stack import (
 
 __all__ = ['config_path', 'executable_path', 'INSTALL_DIR', 'lockstep_parameters',
            'next_domain_id', 'NodeProcess', 'process_report', 'remove_unborn_shm_ports',
-           'REPO_ROOT', 'resume_sim', 'ros_environment', 'spin_until', 'start_node']
+           'REPO_ROOT', 'resume_sim', 'ros_environment', 'spin_until', 'start_node', 'UNBORN_AGE']
 
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
 # stragglers are never heard. Every process (a pytest-xdist worker, another pytest, the
@@ -34,6 +35,7 @@ _BLOCKS = 23  # ROS_DOMAIN_ID 1 .. 230 (Fast DDS allows at most 232)
 _LOCK_DIR = Path(tempfile.gettempdir()) / 'swivel_car_ros_domains'
 _held: list[IO[str]] = []
 _domain_ids: itertools.cycle | None = None
+UNBORN_AGE = 60.0  # [s] see remove_unborn_shm_ports
 
 
 def remove_unborn_shm_ports(shm_dir: Path = Path('/dev/shm')) -> list[str]:
@@ -46,7 +48,12 @@ def remove_unborn_shm_ports(shm_dir: Path = Path('/dev/shm')) -> list[str]:
     rclpy's Node(): seen here, a planner blocked for 15 minutes in
     SharedMemGlobal::open_port_internal, on a port file left six hours earlier. Returns the
     names of the files deleted.
+
+    Only files last changed ``UNBORN_AGE`` or longer ago: a port being created is all zeros
+    for a moment, and its creator may have opened it after this scan read its process.
+    Deleted then, the creator would listen on a file nobody else can open.
     """
+    changed_before = time.time() - UNBORN_AGE  # [s] since the epoch
     held: set[str] = set()
     for process in Path('/proc').iterdir():
         if not process.name.isdigit():
@@ -62,7 +69,7 @@ def remove_unborn_shm_ports(shm_dir: Path = Path('/dev/shm')) -> list[str]:
         if port.name.endswith(('_el', '_sl')) or str(port) in held:
             continue
         try:
-            unborn = not any(port.read_bytes())
+            unborn = port.stat().st_mtime < changed_before and not any(port.read_bytes())
         except OSError:
             continue
         if unborn:
