@@ -10,7 +10,8 @@ from pathlib import Path
 import time
 
 import pytest
-from swivel_car_testing import next_domain_id, NodeProcess, remove_unborn_shm_ports, UNBORN_AGE
+from swivel_car_testing import (
+    DOMAINS_PER_PROCESS, next_domain_id, NodeProcess, remove_unborn_shm_ports, UNBORN_AGE)
 
 
 def left_long_ago(*paths: Path) -> None:
@@ -47,7 +48,7 @@ def test_a_node_whose_port_was_left_unborn_starts_once_it_is_removed():
     # domain where neither exists: written over, a live participant's port is corrupted for
     # good (not all zeros, so never removed), and every later participant 0 of that domain
     # hangs in Node().
-    for _ in range(10):  # next_domain_id's ten
+    for _ in range(DOMAINS_PER_PROCESS):
         domain_id = next_domain_id()
         ports = [Path(f'/dev/shm/fastrtps_port{7400 + 250 * domain_id + offset}')
                  for offset in (10, 11)]

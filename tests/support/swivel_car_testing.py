@@ -24,13 +24,16 @@ from swivel_car_stack import (
 
 __all__ = ['config_path', 'executable_path', 'INSTALL_DIR', 'lockstep_parameters',
            'next_domain_id', 'NodeProcess', 'process_report', 'remove_unborn_shm_ports',
-           'REPO_ROOT', 'resume_sim', 'ros_environment', 'spin_until', 'start_node', 'UNBORN_AGE']
+           'REPO_ROOT', 'resume_sim', 'ros_environment', 'spin_until', 'start_node', 'UNBORN_AGE',
+           'DOMAINS_PER_PROCESS']
 
 # Each test run of real nodes gets its own ROS domain, so parallel runs and earlier tests'
 # stragglers are never heard. Every process (a pytest-xdist worker, another pytest, the
-# benchmark) claims a block of ten ids of its own with a lock file on this host, held until it
-# exits; the search starts at a block chosen by the pid, and skips a block on which a live
-# process still runs (a node a killed test run left: it would talk to this run's nodes).
+# benchmark) claims a block of DOMAINS_PER_PROCESS ids of its own with a lock file on this
+# host, held until it exits; the search starts at a block chosen by the pid, and skips a block
+# on which a live process still runs (a node a killed test run left: it would talk to this
+# run's nodes).
+DOMAINS_PER_PROCESS = 10
 _BLOCKS = 23  # ROS_DOMAIN_ID 1 .. 230 (Fast DDS allows at most 232)
 _LOCK_DIR = Path(tempfile.gettempdir()) / 'swivel_car_ros_domains'
 _held: list[IO[str]] = []
@@ -110,13 +113,18 @@ def domains_in_use(proc: Path = Path('/proc')) -> set[int]:
     return domains
 
 
+def _block_domains(block: int) -> range:
+    """Return the ROS_DOMAIN_IDs of block ``block``."""
+    return range(1 + DOMAINS_PER_PROCESS * block, 1 + DOMAINS_PER_PROCESS * (block + 1))
+
+
 def _claim_block() -> int:
     remove_unborn_shm_ports()
     _LOCK_DIR.mkdir(exist_ok=True)
     in_use = domains_in_use()
     for k in range(_BLOCKS):
         block = (os.getpid() + k) % _BLOCKS
-        if in_use.intersection(range(1 + 10 * block, 11 + 10 * block)):
+        if in_use.intersection(_block_domains(block)):
             continue
         lock = open(_LOCK_DIR / f'{block}.lock', 'w')
         try:
@@ -133,10 +141,9 @@ def next_domain_id() -> int:
     """
     Return a ROS_DOMAIN_ID that no other process using this helper on this host has.
 
-    Nor did the previous nine calls in this process return it.
+    Nor did the previous DOMAINS_PER_PROCESS - 1 calls in this process return it.
     """
     global _domain_ids
     if _domain_ids is None:
-        base = 1 + 10 * _claim_block()
-        _domain_ids = itertools.cycle(range(base, base + 10))
+        _domain_ids = itertools.cycle(_block_domains(_claim_block()))
     return next(_domain_ids)
