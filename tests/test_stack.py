@@ -41,7 +41,7 @@ from rclpy.parameter import Parameter
 from rclpy.task import Future
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
-from sim_session import GroundTruth
+from sim_session import GroundTruth, LOCKSTEP_TIMEOUT
 from std_msgs.msg import Header
 from std_srvs.srv import Empty, SetBool
 from swivel_car_model.params import SwivelCarParams
@@ -65,13 +65,12 @@ UP_LOGS = {'controller': 'controller up', 'odometry': 'odometry up', 'planner': 
 DISCOVERED_BY = {'controller': ('publishers', 'controller/controller_state'),
                  'odometry': ('subscribers', 'joint_states'),
                  'planner': ('services', 'climb_step')}
-# After this many wall seconds without a command the sim takes the controller for gone and
-# runs on at real time with its watchdog (a killed controller); the controller waits half
-# of it for the planner and this test's driver. Long enough that a loaded machine never holds
-# this test's node up beyond the controller's wait: the controller would go on without the
-# driver, take its release late in sim time, and the car would stop that much later than
-# the deadman test allows.
-LOCKSTEP_TIMEOUT = 6.0  # [s], as sim_session.py
+# The chain's LOCKSTEP_TIMEOUT (sim_session.py): after this many wall seconds without a
+# command the sim takes the controller for gone and runs on at real time with its watchdog (a
+# killed controller); the controller waits half of it for the planner and this test's driver.
+# Long enough that a loaded machine never holds this test's node up beyond the controller's
+# wait: the controller would go on without the driver, take its release late in sim time,
+# and the car would stop that much later than the deadman test allows.
 # Messages the test keeps per topic: 10 s of sim time, so an unpaced sim that runs ahead of
 # the test's node (nothing holds it while no one drives) loses none of them on the way.
 QUEUE = 1000

@@ -14,6 +14,7 @@ import pytest
 import rclpy
 from rclpy.context import Context
 from rclpy.experimental import EventsExecutor
+from sim_session import LOCKSTEP_TIMEOUT
 from swivel_car_testing import config_path, next_domain_id, NodeProcess, spin_until
 
 DEADMAN = 2.0  # [s] sim time
@@ -131,13 +132,15 @@ def stack():
     rclpy.init(context=context, domain_id=domain_id)
     processes = [
         NodeProcess('swivel_car_sim', 'sim_node', domain_id,
-                    {'lockstep': True, 'lockstep_timeout': 5.0}),
+                    {'lockstep': True, 'lockstep_timeout': LOCKSTEP_TIMEOUT}),
         # The driver below answers every state with its cmd_vel, and the controller waits for
-        # it (lockstep_cmd_vel). Its first commands come before the chain holds, so the
-        # deadman keeps some slack.
+        # it (lockstep_cmd_vel), longer than a loaded machine holds this process up: waited
+        # 1 s, the controller once went on without it, and the car drove at 0.257 m/s where
+        # 0.3 was commanded. Its first commands come before the chain holds, so the deadman
+        # keeps some slack.
         NodeProcess('swivel_car_control', 'controller_node', domain_id,
                     {'use_sim_time': True, 'cmd_vel_timeout': DEADMAN,
-                     'lockstep_cmd_vel': True, 'lockstep_wait': 1.0},
+                     'lockstep_cmd_vel': True, 'lockstep_wait': LOCKSTEP_TIMEOUT / 2.0},
                     params_file=config_path('swivel_car_control', 'controller_node.yaml')),
         NodeProcess('swivel_car_control', 'odometry_node', domain_id, {'use_sim_time': True},
                     params_file=config_path('swivel_car_control', 'odometry_node.yaml')),

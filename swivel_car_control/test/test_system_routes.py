@@ -28,7 +28,7 @@ import pytest
 import rclpy
 from rclpy.context import Context
 from rclpy.experimental import EventsExecutor
-from sim_session import RESEND_AFTER
+from sim_session import LOCKSTEP_TIMEOUT, RESEND_AFTER
 from std_srvs.srv import Empty, SetBool
 from swivel_car_control.benchmark import routes, Segment
 from swivel_car_control.test.test_system import _seconds, _yaw
@@ -197,7 +197,8 @@ def driver():
     chain = {'real_time_factor': 0.0, 'cmd_vel_driver': True}
     # The sim paused until this node has discovered it (resume_sim).
     processes = [start_node(package, executable, domain_id, {
-        'use_sim_time': True, **lockstep_parameters(executable, 6.0, **chain), **paused})
+        'use_sim_time': True, **lockstep_parameters(executable, LOCKSTEP_TIMEOUT, **chain),
+        **paused})
         for package, executable, paused in (
             ('swivel_car_sim', 'sim_node', {'start_paused': True}),
             ('swivel_car_control', 'controller_node', {}),
