@@ -168,9 +168,14 @@ class SimSession:
         if self._planner:
             self.spin_until(self.climb_action.server_is_ready, timeout, 'the climb action')
             # The planner hears the stack too: a step out of reach is refused as unreachable,
-            # without motion, once it is ready.
+            # without motion, once it is ready. Refused either way, it may be asked twice: a
+            # planner that had not yet discovered this node's response reader dropped the
+            # answer, and the wait for it ran into the test's timeout (BUSY: a copy's answer
+            # came first while the planner still had the other).
             deadline = time.monotonic() + timeout
-            while self.climb(10.0, 1.0).error_code == ClimbStep.Response.ERROR_NOT_READY:
+            out_of_reach = ClimbStep.Request(step_height=10.0, step_distance=1.0)
+            while self.call(self.climb_client, out_of_reach, resend=True).error_code in (
+                    ClimbStep.Response.ERROR_NOT_READY, ClimbStep.Response.ERROR_BUSY):
                 if time.monotonic() > deadline:
                     raise AssertionError('the planner never got ready')
                 self.settle(0.2)
