@@ -15,7 +15,7 @@ import signal
 import subprocess
 import tempfile
 import time
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any, Callable, Iterable, Mapping, Sequence
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 INSTALL_DIR = Path(os.environ.get('SWIVEL_CAR_INSTALL', REPO_ROOT / 'ros2_ws' / 'install'))
@@ -227,14 +227,16 @@ class ResentRequest:
 
 
 def spin_until(executor: Any, condition: Callable[[], bool], timeout: float,
-               what: str = 'condition') -> None:
+               what: str = 'condition', processes: Sequence[NodeProcess] = ()) -> None:
     """
     Spin ``executor`` until ``condition()`` holds.
 
-    TimeoutError after ``timeout`` wall seconds (a guard against a hang, not a measurement).
+    TimeoutError after ``timeout`` wall seconds (a guard against a hang, not a measurement),
+    with what each of ``processes`` printed: the only trace of why a wait ran out.
     """
     deadline = time.monotonic() + timeout
     while not condition():
         if time.monotonic() > deadline:
-            raise TimeoutError(f'timed out after {timeout} s waiting for {what}')
+            report = f'\n{process_report(processes)}' if processes else ''
+            raise TimeoutError(f'timed out after {timeout} s waiting for {what}{report}')
         executor.spin_once(timeout_sec=0.05)

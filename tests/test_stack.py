@@ -48,6 +48,7 @@ from swivel_car_model.params import SwivelCarParams
 from swivel_car_msgs.msg import StepObstacle, SwivelCommand, SwivelControllerState
 from swivel_car_msgs.srv import ClimbStep, ResetSimulation, SpawnObstacle, StepSimulation
 from swivel_car_ros.ros_params import moment_seconds, stamp_to_seconds
+from swivel_car_sim.config import SimParameters
 from swivel_car_sim.sim_node import LOCKSTEP_RESUMED_LOG, LOCKSTEP_TIMED_OUT_LOG
 from swivel_car_testing import (
     lockstep_parameters, next_domain_id, NodeProcess, process_report, resume_sim, spin_until,
@@ -92,7 +93,7 @@ QUIET = 1.0  # [s]
 # Stack.paced: the sim runs this much sim time at a time, so that it never runs ahead of the
 # pace by more.
 PACE_SLICE = 0.02  # [s]
-TIME_STEP = 0.002  # [s] sim_node.yaml
+PACE_STEPS = round(PACE_SLICE / SimParameters().time_step)  # [1] physics steps of a slice
 # Wall time a restarted node that is up may take to show in this node's graph while the sim
 # waits paused for it (Stack.restart).
 DISCOVERY_WAIT = 5.0  # [s]
@@ -434,8 +435,7 @@ class Stack:
         if time.monotonic() < self._pace_started + self._pace_interval:
             return
         self._pace_started = time.monotonic()
-        self._pace = self.run_sim.call_async(
-            StepSimulation.Request(steps=round(PACE_SLICE / TIME_STEP)))
+        self._pace = self.run_sim.call_async(StepSimulation.Request(steps=PACE_STEPS))
 
     def spin_until(self, condition, timeout: float = 60.0, what: str = 'condition') -> None:
         def checked() -> bool:
@@ -446,12 +446,7 @@ class Stack:
             if self._pace_interval is not None:
                 self._run_slice_when_due()
             return False
-        try:
-            spin_until(self.executor, checked, timeout, what)
-        except TimeoutError as error:
-            # What each node said is the only trace of why a wait ran out.
-            raise TimeoutError(
-                f'{error}\n{process_report(self.processes.values())}') from None
+        spin_until(self.executor, checked, timeout, what, list(self.processes.values()))
 
     def call(self, client, request, what: str):
         self.spin_until(client.service_is_ready, 60.0, f'the {what} service')

@@ -38,8 +38,7 @@ from swivel_car_msgs.srv import ResetSimulation
 from swivel_car_ros.lockstep import ChainEntry, Entry, stamp_ns
 from swivel_car_stack import ResentRequest
 from swivel_car_testing import (
-    lockstep_parameters, next_domain_id, NodeProcess, process_report, resume_sim, spin_until,
-    start_node)
+    lockstep_parameters, next_domain_id, NodeProcess, resume_sim, spin_until, start_node)
 
 SETTLE = 1.0  # [s] sim time standing still at the end of a route, as the benchmark
 # Our odometry's end-pose error, % of the distance travelled; the in-process benchmark
@@ -133,11 +132,7 @@ class RouteDriver:
         self.cmd_vel.publish(command)
 
     def spin_until(self, condition, timeout: float, what: str) -> None:
-        try:
-            spin_until(self.executor, condition, timeout, what)
-        except TimeoutError as error:
-            # What each node said is the only trace of why a wait ran out.
-            raise TimeoutError(f'{error}\n{process_report(self.processes)}') from None
+        spin_until(self.executor, condition, timeout, what, self.processes)
 
     def call(self, client, request) -> None:
         """Call a service whose request may come twice (a reset), resent until answered."""

@@ -36,8 +36,7 @@ except ImportError:  # outside pytest: the repository's helpers (pytest.ini puts
     _REPO = Path(__file__).resolve().parents[2]
     sys.path += [str(_REPO / 'scripts'), str(_REPO / 'tests' / 'support')]
     from swivel_car_testing import next_domain_id, spin_until
-from swivel_car_stack import (
-    lockstep_parameters, NodeProcess, process_report, ResentRequest, start_node)
+from swivel_car_stack import lockstep_parameters, NodeProcess, ResentRequest, start_node
 
 CLIMB_WALL_LIMIT = 600.0  # [s] guard against a hung stack, not a measurement
 # [s] wall; half of it the controller waits for the planner. A loaded CI machine held a
@@ -143,11 +142,7 @@ class SimSession:
         self.controller_state = msg
 
     def spin_until(self, condition: Callable[[], bool], timeout: float, what: str) -> None:
-        try:
-            spin_until(self.executor, condition, timeout, what)
-        except TimeoutError as error:
-            # What each node said is the only trace of why a load-dependent wait ran out.
-            raise TimeoutError(f'{error}\n{process_report(self.processes)}') from None
+        spin_until(self.executor, condition, timeout, what, self.processes)
 
     def wait_ready(self, timeout: float = 60.0) -> None:
         """
