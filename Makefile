@@ -17,7 +17,7 @@ BUILT := ros2_ws/install/.swivel_car_built_msgs_cpp_$(MSGS_CPP)$(if \
     $(TF2_MSGS_UNDERLAY),_tf2_msgs_underlay)
 IN_WS := scripts/in_ws
 PYTEST_ARGS ?=
-PYTEST_WORKERS ?= $(shell echo $$(( $$(nproc) + 1 )))
+PYTEST_WORKERS ?= auto
 
 .PHONY: setup build test test-repeat demo figures bench soak clean
 
@@ -74,10 +74,9 @@ $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	wait $$python_packages && wait $$warm_bytecode && exit $$msgs
 	touch $@
 
-# Test files run side by side, one pytest-xdist worker more than cores (PYTEST_WORKERS=0: in
-# one process): a worker waits part of the time (discovery, a node's start), and on the 2-core
-# machine 3 workers took 118-129 s where 2 took 141 s. Each worker claims its own block of ROS
-# domain ids. A file stays on one worker (module fixtures carry a stack from test to test), in
+# Test files run side by side, two pytest-xdist workers more than cores (PYTEST_WORKERS=auto,
+# conftest.py says why; PYTEST_WORKERS=0: in one process). Each worker claims its own block of
+# ROS domain ids. A file stays on one worker (module fixtures carry a stack from test to test), in
 # the order pytest.ini lists them.
 # Foxglove's own bag parsers for tests/test_tf.py, from npm, pinned by the lock file (10
 # packages, 4 MB: 4 s).

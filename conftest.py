@@ -14,6 +14,13 @@ default 200 ms with three test processes on two cores).
 
 The files pytest.ini names in ``run_first`` are collected first, in that order.
 
+``-n auto`` (``make test``) starts two pytest-xdist workers more than the cores the process may
+run on: a worker waits part of the time (the stack test's wall-paced drives, the hardware test
+on the system clock, a node's start and discovery), and with one worker more than cores the
+suite kept only 1.7 of the 2 cores busy. On the 2-core machine 4 workers took 117-123 s where
+3 took 131-137 s; with one core kept busy (``make test-repeat HOG=1``), 153-165 s where 3 took
+166-181 s. PYTEST_XDIST_AUTO_NUM_WORKERS overrides it, as pytest-xdist documents.
+
 Every participant of the test processes, and of the nodes they start (which inherit the
 environment), reads tests/support/fastdds_test_profile.xml: under the suite's load the
 default socket buffers dropped datagrams (Udp RcvbufErrors), and a reliable topic then
@@ -38,6 +45,12 @@ for package in ('swivel_car_control', 'swivel_car_model', 'swivel_car_perception
 settings.register_profile('deterministic', derandomize=True, deadline=None)
 settings.register_profile('explore', derandomize=False, deadline=None)
 settings.load_profile(os.environ.get('HYPOTHESIS_PROFILE', 'deterministic'))
+
+
+def pytest_xdist_auto_num_workers(config):
+    if 'PYTEST_XDIST_AUTO_NUM_WORKERS' in os.environ:
+        return None  # pytest-xdist's own hook reads it
+    return len(os.sched_getaffinity(0)) + 2
 
 
 def pytest_addoption(parser):

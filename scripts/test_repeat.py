@@ -12,7 +12,6 @@ the nodes' logs the system tests attach) are kept in a directory it names.
 
 import argparse
 import collections
-import os
 from pathlib import Path
 import subprocess
 import sys
@@ -56,8 +55,8 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--runs', type=int, default=5, help='how many runs (default 5)')
     parser.add_argument('--hog', action='store_true', help='keep one core busy meanwhile')
-    parser.add_argument('--workers', default=str((os.cpu_count() or 1) + 1),
-                        help='pytest-xdist workers, as make test (default: cores + 1)')
+    parser.add_argument('--workers', default='auto',
+                        help="pytest-xdist workers, as make test (default: auto, conftest.py's)")
     parser.add_argument('pytest_args', nargs='*', help='more pytest arguments')
     args = parser.parse_args()
     if args.runs < 1:
