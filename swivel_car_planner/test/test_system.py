@@ -13,6 +13,7 @@ from sim_session import SimSession
 from swivel_car_msgs.action import ClimbStep as ClimbStepAction
 from swivel_car_msgs.srv import ClimbStep
 from swivel_car_planner.core import ErrorCode, Phase
+from swivel_car_stack import process_report
 
 HEIGHT = 0.04  # [m] within the rear axle's traction limit (README: measured limits)
 DISTANCE = 1.2  # [m]
@@ -79,12 +80,19 @@ def test_second_goal_is_refused_and_cancel_stops_the_car_safely(stack):
     def run_until(phase: Phase) -> None:
         # A few control periods at a time, each ending paused: the cancel lands while the
         # wheel is up however fast the sim runs (pausing on seeing the phase came too late
-        # once the chain ran through the advance before the pause).
-        for _ in range(2000):
+        # once the chain ran through the advance before the pause). A climb that ends on the
+        # way (its result arrives) fails here with the planner's reason and the nodes' output.
+        for _ in range(2000):  # 100 s of sim time; ADVANCE comes after about 9
             if feedback and feedback[-1].phase >= phase:
                 return
+            if result.done():
+                ended = result.result()
+                raise AssertionError(
+                    f'the climb ended before {phase.name} (status {ended.status}): '
+                    f'{ended.result.message}\n{process_report(stack.processes, 4000)}')
             stack.run(RUN_STEPS)
-        raise AssertionError(f'no {phase.name} within 2000 runs: {feedback[-1:]}')
+        raise AssertionError(f'no {phase.name} within 2000 runs: {feedback[-1:]}\n'
+                             f'{process_report(stack.processes, 4000)}')
 
     stack.set_paused(True)
     goal = ClimbStepAction.Goal(step_height=HEIGHT, step_distance=DISTANCE)
@@ -93,6 +101,7 @@ def test_second_goal_is_refused_and_cancel_stops_the_car_safely(stack):
     stack.spin_until(sent.done, 30.0, 'goal response')
     handle = sent.result()
     assert handle.accepted
+    result = handle.get_result_async()
     run_until(Phase.LIFT)
     # A second goal and a service call meanwhile: both refused, the climb goes on.
     second = stack.climb_action.send_goal_async(goal)
@@ -105,7 +114,6 @@ def test_second_goal_is_refused_and_cancel_stops_the_car_safely(stack):
     cancel = handle.cancel_goal_async()
     stack.spin_until(cancel.done, 30.0, 'the cancel response')
     stack.set_paused(False)
-    result = handle.get_result_async()
     stack.spin_until(result.done, 60.0, 'the canceled result')
     assert cancel.done()
     assert result.result().status == GoalStatus.STATUS_CANCELED, result.result().result.message
