@@ -74,7 +74,7 @@ $(BUILT): $(STAMP) $(BUILD_INPUTS) Makefile
 	wait $$python_packages && wait $$warm_bytecode && exit $$msgs
 	touch $@
 
-# Test files run side by side, two pytest-xdist workers more than cores (PYTEST_WORKERS=auto,
+# Test files run side by side, one pytest-xdist worker more than cores (PYTEST_WORKERS=auto,
 # conftest.py says why; PYTEST_WORKERS=0: in one process). Each worker claims its own block of
 # ROS domain ids. A file stays on one worker (module fixtures carry a stack from test to test), in
 # the order pytest.ini lists them.
