@@ -35,7 +35,7 @@ def test_a_block_with_a_live_process_on_one_of_its_domains_is_skipped(tmp_path, 
     block = os.getpid() % swivel_car_testing._BLOCKS  # the block this process would try first
     monkeypatch.setattr(swivel_car_testing, '_LOCK_DIR', Path(tmp_path))
     monkeypatch.setattr(swivel_car_testing, 'remove_unborn_shm_ports', lambda: [])
-    in_block = swivel_car_testing.DOMAINS_PER_PROCESS * block + 7  # one of its domains
+    in_block = swivel_car_testing._block_domains(block)[6]  # one of its domains
     monkeypatch.setattr(swivel_car_testing, 'domains_in_use', lambda: {in_block})
     claimed = swivel_car_testing._claim_block()
     try:

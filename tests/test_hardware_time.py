@@ -109,11 +109,15 @@ def test_drive_by_cmd_vel_then_climb_a_5_cm_step_on_the_system_clock(hardware_st
         assert not dead, process_report(dead)
         return False
 
+    def wait_for(condition, timeout: float, what: str) -> None:
+        """spin_until, with what every node printed if the wait runs out."""
+        spin_until(executor, condition, timeout, what, processes)
+
     # cmd_vel sent before the controller's subscription has matched is lost, as on the robot.
-    spin_until(executor, lambda: alive() or (truth and odom and spawn.service_is_ready()
-                                             and climb.service_is_ready()
-                                             and cmd_vel.get_subscription_count() > 0),
-               START_TIMEOUT, 'the stack')
+    wait_for(lambda: alive() or (truth and odom and spawn.service_is_ready()
+                                 and climb.service_is_ready()
+                                 and cmd_vel.get_subscription_count() > 0),
+             START_TIMEOUT, 'the stack')
     # Stamps of the system clock, as the robot's.
     assert abs(stamp_to_seconds(truth[-1].header.stamp) - time.time()) < 5.0
 
@@ -130,21 +134,20 @@ def test_drive_by_cmd_vel_then_climb_a_5_cm_step_on_the_system_clock(hardware_st
         message.header.stamp = node.get_clock().now().to_msg()
         message.twist.linear.x = 0.3  # [m/s]
         cmd_vel.publish(message)
-        spin_until(executor, lambda n=len(truth): alive() or len(truth) > n + 4, 30.0,
-                   'ground truth while driving')
+        wait_for(lambda n=len(truth): alive() or len(truth) > n + 4, 30.0,
+                 'ground truth while driving')
     # Released: the cmd_vel deadman stops the car, which then stands for the climb's plan.
     # Standing, not one slow sample: the drive motor's speed loop (damping ratio 0.7,
     # swivel_car_sim.drive_train) overshoots the stop, and the car rolls back about 1.5 cm
     # over the next 0.5 s, through a sample below STANDING_SPEED at the turning point.
-    spin_until(executor, lambda: alive() or standing(truth), 30.0,
-               'the car to stand (cmd_vel deadman)')
+    wait_for(lambda: alive() or standing(truth), 30.0, 'the car to stand (cmd_vel deadman)')
     driven = GroundTruth.from_msg(truth[-1])
 
     p = SwivelCarParams()
     spawned = spawn.call_async(SpawnObstacle.Request(obstacle=StepObstacle(
         name='step', height=STEP_HEIGHT, depth=1.5, width=STEP_WIDTH, distance=STEP_DISTANCE,
         yaw=0.0, friction=1.0)))
-    spin_until(executor, spawned.done, 30.0, 'spawn_obstacle')
+    wait_for(spawned.done, 30.0, 'spawn_obstacle')
     assert spawned.result().success, spawned.result().message
     edge_x = driven.x + p.wheelbase + STEP_DISTANCE
     asked_until = time.monotonic() + START_TIMEOUT
@@ -153,7 +156,7 @@ def test_drive_by_cmd_vel_then_climb_a_5_cm_step_on_the_system_clock(hardware_st
         answer = climb.call_async(ClimbStep.Request(
             step_height=STEP_HEIGHT, step_distance=STEP_DISTANCE, step_yaw=0.0,
             step_width=STEP_WIDTH, plan_only=False))
-        spin_until(executor, lambda: alive() or answer.done(), CLIMB_TIMEOUT, 'climb_step')
+        wait_for(lambda: alive() or answer.done(), CLIMB_TIMEOUT, 'climb_step')
         result = answer.result()
         # Refused as not ready before anything moved (an input over ready_timeout old: under
         # a full make test the controller or odometry process went unscheduled for a second):
@@ -164,7 +167,7 @@ def test_drive_by_cmd_vel_then_climb_a_5_cm_step_on_the_system_clock(hardware_st
                 or time.monotonic() > asked_until:
             break
         wait = time.monotonic() + 0.5  # [s] wall
-        spin_until(executor, lambda: alive() or time.monotonic() > wait, 5.0, 'a pause')
+        wait_for(lambda: alive() or time.monotonic() > wait, 5.0, 'a pause')
     assert result.success, f'{result.error_code}: {result.message}\n' + process_report(
         processes, 4000)
     final = GroundTruth.from_msg(truth[-1])
